@@ -1,0 +1,215 @@
+#include <fmt/core.h>
+
+#include <array>
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "core/count.hpp"
+#include "explore/grid.hpp"
+#include "explore/job.hpp"
+#include "explore/mpi.hpp"
+#include "explore/progress.hpp"
+#include "explore/schedule.hpp"
+#include "explore/signals.hpp"
+#include "io/result_file.hpp"
+#include "io/xdmf.hpp"
+#include "superball/version.hpp"
+
+namespace superball::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ExploreOptions {
+    std::string job;
+    std::string output;
+    bool resume = false;
+    bool overwrite = false;
+    bool quiet = false;
+};
+
+enum class Mode : std::int64_t { fresh, resume, complete, refuse };
+
+// Rank 0 decides what to do with the output path; the others are told.
+struct Decision {
+    Mode mode = Mode::fresh;
+    std::string message;  // why a run is refused, or a note
+};
+
+Decision decide(const ExploreOptions& opt, const fs::path& out, const Job& job)
+{
+    std::error_code ec;
+    if (!fs::exists(out, ec)) {
+        return {Mode::fresh, opt.resume ? "no result at " + out.string() + " to resume: starting a new run" : ""};
+    }
+    if (opt.overwrite) return {Mode::fresh, "replacing " + out.string() + " (--overwrite)"};
+    ResultInfo info;
+    try {
+        info = read_result_info(out);
+    } catch (const std::exception& e) {
+        return {Mode::refuse, out.string() + " exists and is not a readable superball result (" + e.what() +
+                                  "); it is left alone: choose another --output, or --overwrite to replace it"};
+    }
+    if (!opt.resume) {
+        if (info.complete) {
+            return {Mode::refuse, out.string() + " already holds a complete result; use --overwrite to replace it or "
+                                                 "--output to write elsewhere"};
+        }
+        return {Mode::refuse, fmt::format("{} holds an interrupted run ({} of {} tiles done); add --resume to finish it "
+                                          "or --overwrite to start again",
+                                          out.string(), info.tiles_done, info.tiles)};
+    }
+    if (info.job_fingerprint != fingerprint(job)) {
+        return {Mode::refuse, out.string() + " was made by a different job (grid, model or max_bounces differ); "
+                                             "refusing to mix results: use another --output, or --overwrite"};
+    }
+    if (info.software_version != software_version) {
+        return {Mode::refuse, fmt::format("{} was made by superball {}, this is {}; refusing to mix results of two "
+                                          "versions: use another --output, or --overwrite",
+                                          out.string(), info.software_version, software_version)};
+    }
+    if (info.complete) return {Mode::complete, out.string() + " is already complete: nothing to do"};
+    return {Mode::resume, fmt::format("resuming {}: {} of {} tiles already done", out.string(), info.tiles_done, info.tiles)};
+}
+
+void print_summary(const Job& job, const fs::path& out, const Progress& progress,
+                   const std::vector<std::uint64_t>& histogram, bool complete)
+{
+    const double s = progress.seconds();
+    const auto n = progress.points_this_run();
+    fmt::print(stderr, "{}: {} points computed in {:.2f} s ({:.3g} points/s), grid of {} points\n",
+               complete ? "done" : "interrupted", n, s, s > 0 ? static_cast<double>(n) / s : 0.0, job.points());
+    std::string line = "outcomes this run:";
+    for (int o = 0; o < outcome_count; ++o) {
+        const double frac = n ? static_cast<double>(histogram[static_cast<std::size_t>(o)]) / static_cast<double>(n) : 0.0;
+        line += fmt::format("  {} {} ({:.2f}%)", name(static_cast<Outcome>(o)), histogram[static_cast<std::size_t>(o)],
+                            100.0 * frac);
+    }
+    fmt::print(stderr, "{}\n", line);
+    fmt::print(stderr, "result: {}\n", out.string());
+}
+
+int explore(const ExploreOptions& opt)
+{
+    const mpi::Environment env;
+    const mpi::Comm world = mpi::Comm::world();
+    const bool root = world.is_root();
+    h5::silence_errors();
+    try {
+        const Job job = load_job(opt.job);
+        const fs::path out = opt.output.empty() ? fs::path(job.output) : fs::path(opt.output);
+        if (out.empty()) throw InputError("no output file: set [run] output in " + opt.job + " or give --output");
+
+        Decision d;
+        if (root) {
+            d = decide(opt, out, job);
+            if (d.mode == Mode::fresh && out.has_parent_path()) fs::create_directories(out.parent_path());
+        }
+        d.mode = static_cast<Mode>(world.broadcast(static_cast<std::int64_t>(d.mode)));
+        world.broadcast(d.message);
+        if (d.mode == Mode::refuse) throw InputError(d.message);
+        if (root && !d.message.empty() && !opt.quiet) fmt::print(stderr, "{}\n", d.message);
+        if (d.mode == Mode::complete) return 0;
+
+        const StopSignals signals;
+        const Grid grid(job);
+        const Extent shape = grid.shape();
+        const std::uint64_t tile_points = job.tile_points.value_or(default_tile_points(job.points(), world.size()));
+        ResultFile file = d.mode == Mode::fresh
+                              ? ResultFile::create(out, world, job, grid, Tiling(shape, default_tile_shape(shape, tile_points)))
+                              : ResultFile::open(out, world);
+        const Tiling& tiling = file.tiling();
+
+        std::deque<std::uint64_t> pending;
+        std::uint64_t done_tiles = 0, done_points = 0;
+        if (root) {
+            const std::vector<std::uint8_t> done = file.tiles_done();
+            for (std::uint64_t t = 0; t < done.size(); ++t) {
+                if (done[t]) {
+                    ++done_tiles;
+                    done_points += tiling.box(t).points();
+                } else {
+                    pending.push_back(t);
+                }
+            }
+            if (!opt.quiet) {
+                fmt::print(stderr, "superball explore: {} points ({} tiles of up to {} points) on {} rank{}\n",
+                           job.points(), tiling.tiles(), tiling.box(0).points(), world.size(),
+                           world.size() == 1 ? "" : "s");
+            }
+        }
+        Progress progress(stderr, tiling.tiles(), tiling.points(), done_tiles, done_points);
+
+        const ModelMatrices matrices = ModelMatrices::of(job.model);
+        std::vector<CanonicalState<double>> starts;
+        std::vector<std::uint32_t> counts;
+        std::vector<std::uint8_t> outcomes;
+        std::vector<std::uint64_t> histogram(outcome_count, 0);
+        // Rank 0 answers requests this often (in points) while it computes.
+        constexpr std::size_t block = 256;
+        const TileWork work = [&](std::uint64_t t, const Serve& serve) {
+            grid.starts(tiling.box(t), starts);
+            counts.resize(starts.size());
+            outcomes.resize(starts.size());
+            for (std::size_t i = 0; i < starts.size(); i += block) {
+                const std::size_t n = std::min(block, starts.size() - i);
+                count_each(std::span(starts).subspan(i, n), matrices, job.max_bounces, std::span(counts).subspan(i, n),
+                           std::span(outcomes).subspan(i, n));
+                serve();
+            }
+            file.write_tile(t, counts, outcomes);
+            for (const std::uint8_t o : outcomes) ++histogram[o];
+        };
+        const TileDone on_done = [&](std::uint64_t t, int) {
+            if (!opt.quiet) progress.tile_done(tiling.box(t).points());
+        };
+        const ScheduleResult r = run_schedule(world, std::move(pending), work, on_done, &StopSignals::requested);
+
+        // Attributes are written collectively and must be identical on every rank.
+        file.finish(world.broadcast(progress.seconds()), world.size(), !r.interrupted);
+        const std::vector<std::uint64_t> total = world.sum(histogram);
+        if (root) {
+            if (!opt.quiet) progress.finish();
+            write_xdmf(out, read_result_info(out));
+            print_summary(job, out, progress, total, !r.interrupted);
+            if (r.interrupted) {
+                fmt::print(stderr, "stopped by a signal: {} is consistent and incomplete; run the same command with "
+                                   "--resume to finish it\n",
+                           out.string());
+            }
+        }
+        return r.interrupted ? 1 : 0;
+    } catch (const InputError& e) {
+        // Every rank reads the same job and gets the same verdict: one message is enough.
+        if (root) fmt::print(stderr, "superball explore: {}\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        // Past the job's validation the ranks may no longer be in step: end them all.
+        fmt::print(stderr, "superball explore (rank {}): error: {}\n", world.rank(), e.what());
+        world.abort(1);
+    }
+}
+
+}  // namespace
+
+Runner add_explore_command(CLI::App& app)
+{
+    auto* sub = app.add_subcommand("explore", "Count wall bounces over a grid of starts (run under mpirun)");
+    sub->footer(
+        "Run as `mpirun -n P superball explore JOB.toml` (P >= 1; every rank computes). The result is one HDF5\n"
+        "file (SPEC.md section 5) plus a .xmf sidecar for ParaView. An existing result is never overwritten\n"
+        "unless --overwrite is given; --resume finishes an interrupted run of the same job (a different job\n"
+        "is refused). SIGINT/SIGTERM stop cleanly (resumable); a second signal stops at once (still resumable).");
+    auto opt = std::make_shared<ExploreOptions>();
+    sub->add_option("job", opt->job, "TOML job file (SPEC.md section 4)")->required();
+    sub->add_option("-o,--output", opt->output, "result file (default: [run] output of the job)");
+    sub->add_flag("--resume", opt->resume, "finish an interrupted run of the same job in the output file");
+    auto* overwrite = sub->add_flag("--overwrite", opt->overwrite, "replace an existing output file");
+    sub->get_option("--resume")->excludes(overwrite);
+    sub->add_flag("-q,--quiet", opt->quiet, "no progress lines");
+    return [opt] { return explore(*opt); };
+}
+
+}  // namespace superball::cli

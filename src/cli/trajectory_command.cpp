@@ -1,0 +1,108 @@
+#include <fmt/core.h>
+#include <fmt/os.h>
+
+#include <memory>
+
+#include "commands.hpp"
+#include "core/trajectory.hpp"
+#include "options.hpp"
+
+namespace superball::cli {
+
+namespace {
+
+struct TrajectoryOptions {
+    ModelInput model;
+    StartFlags start;
+    std::uint32_t max_bounces = 1000;
+    std::string format = "csv";
+    int samples = 0;
+    std::string output;
+};
+
+// Every double is printed with the shortest text that reads back to the same value.
+void write_csv(std::FILE* f, const Trajectory& tr, double radius)
+{
+    fmt::print(f, "event,wall_bounces,t,x,y,u_in,v_in,omega_in,u,v,omega\n");
+    for (const Event& e : tr.events) {
+        fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", name(e.kind), e.wall_bounces, e.t, e.x, e.y, e.before.u,
+                   e.before.v, e.before.W / radius, e.after.u, e.after.v, e.after.W / radius);
+    }
+    // Flight-path samples: same columns, the velocity at the sample on both sides.
+    for (const PathPoint& p : tr.path) {
+        const double omega = tr.events[p.segment].after.W / radius;
+        fmt::print(f, "path,{},{},{},{},{},{},{},{},{},{}\n", tr.events[p.segment].wall_bounces, p.t, p.x, p.y, p.u, p.v,
+                   omega, p.u, p.v, omega);
+    }
+}
+
+void write_json(std::FILE* f, const Trajectory& tr, const Start& start, const Model& m)
+{
+    const double a = start.frame.radius;
+    fmt::print(f, "{{\n  \"units\": \"{}\",\n", start.physical ? "SI" : "dimensionless (v0 = g = radius = 1)");
+    fmt::print(f, "  \"g\": {}, \"radius\": {},\n", start.frame.g, a);
+    fmt::print(f, "  \"model\": {{\"e_wall\": {}, \"alpha_wall\": {}, \"e_floor\": {}, \"alpha_floor\": {}}},\n", m.wall.e,
+               m.wall.alpha, m.floor.e, m.floor.alpha);
+    fmt::print(f, "  \"start\": {{\"xi\": {}, \"U\": {}, \"W\": {}}},\n", start.canonical.xi, start.canonical.U,
+               start.canonical.W);
+    fmt::print(f, "  \"wall_bounces\": {}, \"outcome\": \"{}\",\n  \"events\": [", tr.result.wall_bounces,
+               name(tr.result.outcome));
+    const char* sep = "\n";
+    for (const Event& e : tr.events) {
+        fmt::print(f,
+                   "{}    {{\"event\": \"{}\", \"wall_bounces\": {}, \"t\": {}, \"x\": {}, \"y\": {}, \"u_in\": {}, "
+                   "\"v_in\": {}, \"omega_in\": {}, \"u\": {}, \"v\": {}, \"omega\": {}}}",
+                   sep, name(e.kind), e.wall_bounces, e.t, e.x, e.y, e.before.u, e.before.v, e.before.W / a, e.after.u,
+                   e.after.v, e.after.W / a);
+        sep = ",\n";
+    }
+    fmt::print(f, "\n  ],\n  \"path\": [");
+    sep = "\n";
+    for (const PathPoint& p : tr.path) {
+        fmt::print(f, "{}    {{\"segment\": {}, \"t\": {}, \"x\": {}, \"y\": {}, \"u\": {}, \"v\": {}}}", sep, p.segment, p.t,
+                   p.x, p.y, p.u, p.v);
+        sep = ",\n";
+    }
+    fmt::print(f, "\n  ]\n}}\n");
+}
+
+}  // namespace
+
+Runner add_trajectory_command(CLI::App& app)
+{
+    auto* sub = app.add_subcommand("trajectory", "Print every impact of one start point (CSV or JSON)");
+    sub->footer(
+        "Events: launch, wall (impact), floor (bounce), land (the floor contact after the motion ended,\n"
+        "recorded, not applied). Columns: time t, centre (x, y), velocities and spin arriving (_in) and\n"
+        "leaving. A canonical start is followed in dimensionless units (v0 = g = radius = 1, so omega = W);\n"
+        "a physical start in SI units. --samples K adds K points on every flight (event 'path') for plotting.");
+    auto opt = std::make_shared<TrajectoryOptions>();
+    add_model_flags(*sub, opt->model);
+    add_start_flags(*sub, opt->start);
+    add_max_bounces_flag(*sub, opt->max_bounces);
+    sub->add_option("--format", opt->format, "csv or json")->check(CLI::IsMember({"csv", "json"}))->capture_default_str();
+    sub->add_option("--samples", opt->samples, "points sampled on each flight parabola (0: none, otherwise >= 2)")
+        ->check(CLI::Range(0, 100000));
+    sub->add_option("-o,--output", opt->output, "write to this file instead of standard output");
+    return [opt] {
+        const Model model = resolve_model(opt->model, flag_spelling);
+        const Start start = resolve_start(opt->start);
+        if (opt->samples == 1) throw InputError("--samples = 1 is out of range: accepted 0 or 2..100000");
+        const Trajectory tr = trajectory(start.state, model, start.frame.g, opt->max_bounces, opt->samples);
+        std::FILE* f = stdout;
+        std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
+        if (!opt->output.empty()) {
+            file.reset(std::fopen(opt->output.c_str(), "w"));
+            if (!file) throw std::runtime_error("cannot write " + opt->output);
+            f = file.get();
+        }
+        if (opt->format == "json") {
+            write_json(f, tr, start, model);
+        } else {
+            write_csv(f, tr, start.frame.radius);
+        }
+        return 0;
+    };
+}
+
+}  // namespace superball::cli

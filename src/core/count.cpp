@@ -1,0 +1,48 @@
+#include "count.hpp"
+
+namespace superball {
+
+std::optional<Outcome> outcome_from_name(std::string_view s)
+{
+    for (int i = 0; i < outcome_count; ++i) {
+        const auto o = static_cast<Outcome>(i);
+        if (name(o) == s) return o;
+    }
+    return std::nullopt;
+}
+
+BounceCount count(const CanonicalState<double>& start, const ModelMatrices& m, std::uint32_t max_bounces)
+{
+    if (!is_launch(start)) return {0, Outcome::invalid};
+    CanonicalState<double> c = start;
+    std::uint32_t n = 0;
+    for (;;) {
+        // Written as !(xi < 1) so that a state that has lost all meaning (NaN) stops as a
+        // miss instead of running to max_bounces.
+        if (!(c.xi < 1.0)) return {n, Outcome::missed};
+        // Capped means the ball would hit the wall once more: a ball whose next
+        // excursion misses is reported as missed even at the cap.
+        if (n >= max_bounces) return {n, Outcome::capped};
+        c = canonical_map(c, m).next;
+        ++n;
+        if (c.U >= 0.0) return {n, Outcome::left};
+    }
+}
+
+void count_each(std::span<const CanonicalState<double>> starts, const ModelMatrices& m, std::uint32_t max_bounces,
+                std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
+{
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        const BounceCount r = count(starts[i], m, max_bounces);
+        wall_bounces[i] = r.wall_bounces;
+        outcomes[i] = static_cast<std::uint8_t>(r.outcome);
+    }
+}
+
+BounceCount count(const PhysicalState<double>& start, const Model& m, double g, std::uint32_t max_bounces)
+{
+    if (!is_launch(start) || !(g > 0.0)) return {0, Outcome::invalid};
+    return count(to_canonical(start, g), m, max_bounces);
+}
+
+}  // namespace superball

@@ -1,0 +1,36 @@
+// Resolving user input (command-line flags or job-file keys) into a Model, with
+// messages that name the offending key. Shared by the command line and the job parser
+// so that both accept exactly the same things.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "model.hpp"
+
+namespace superball {
+
+// Bad input: the message names the key, the value and what is accepted. Exit status 2.
+struct InputError : std::invalid_argument {
+    using std::invalid_argument::invalid_argument;
+};
+
+// The coefficients as given: `e` and `alpha` set both surfaces, per-surface keys override.
+struct ModelInput {
+    std::optional<double> e, alpha, e_wall, alpha_wall, e_floor, alpha_floor;
+};
+
+// Spells a key the way the user wrote it: "e_wall" for job files, "--e-wall" on the
+// command line.
+using KeySpelling = std::function<std::string(std::string_view key)>;
+
+// Throws InputError if a coefficient is missing or out of its physical range.
+Model resolve_model(const ModelInput& in, const KeySpelling& spell);
+
+// Shortest text that reads back as the same double (for messages and attributes).
+std::string format_double(double x);
+
+}  // namespace superball

@@ -1,0 +1,110 @@
+// The floor -> wall -> floor map: physical (F) and canonical (G), SPEC.md sections 1-2.
+//
+// Each map is written once, as a template on the number type T (double, or a SIMD
+// batch of doubles in the vectorised kernel) so both instantiations evaluate the same
+// operations in the same order.
+#pragma once
+
+#include <cmath>
+
+#include "impact.hpp"
+#include "state.hpp"
+
+namespace superball {
+
+namespace detail {
+// sqrt that finds the SIMD overload by argument-dependent lookup.
+using std::sqrt;
+template <class T>
+T root(const T& x)
+{
+    return sqrt(x);
+}
+}  // namespace detail
+
+// Flight from the floor to the wall (seed eqs. 1 and 4).
+template <class T>
+struct WallArrival {
+    T t;    // flight time -x/u
+    T y;    // height of the centre at the wall; <= 0: the ball lands first (missed)
+    T v_w;  // vertical velocity at the wall
+};
+
+template <class T>
+constexpr WallArrival<T> flight_to_wall(const PhysicalState<T>& s, double g)
+{
+    const T r = s.x / s.u;  // = -t
+    return {-r, -r * (s.v + g * s.x / (2.0 * s.u)), s.v + g * r};
+}
+
+// Flight from height y back to the floor after the wall impact.
+template <class T>
+struct FloorArrival {
+    T t;    // flight time T = (v+ - v_f)/g
+    T x;    // x_{n+1} = u+ T
+    T v_f;  // vertical velocity on arrival, -sqrt(v+^2 + 2 g y)
+};
+
+template <class T>
+constexpr FloorArrival<T> flight_to_floor(const Velocities<T>& after_wall, const T& y, double g)
+{
+    const T v_f = -detail::root(after_wall.v * after_wall.v + 2.0 * g * y);
+    const T t = (after_wall.v - v_f) / g;
+    return {t, after_wall.u * t, v_f};
+}
+
+// Everything an excursion produces; the physical map F is its `next` state.
+template <class T>
+struct Excursion {
+    WallArrival<T> to_wall;
+    Velocities<T> after_wall;
+    FloorArrival<T> to_floor;
+    PhysicalState<T> next;  // state just after the floor bounce
+};
+
+// One excursion n -> n+1 in physical variables. Valid when the wall is reached
+// (to_wall.y > 0); the caller decides what a miss means.
+template <class T>
+constexpr Excursion<T> excursion(const PhysicalState<T>& s, const ModelMatrices& m, double g)
+{
+    const WallArrival<T> w = flight_to_wall(s, g);
+    const Velocities<T> after_wall = wall_impact(Velocities<T>{s.u, w.v_w, s.W}, m.wall);
+    const FloorArrival<T> f = flight_to_floor(after_wall, w.y, g);
+    const Velocities<T> after_floor = floor_impact(Velocities<T>{after_wall.u, f.v_f, after_wall.W}, m.floor);
+    return {w, after_wall, f, {f.x, after_floor.u, after_floor.v, after_floor.W}};
+}
+
+// F: the physical map.
+template <class T>
+constexpr PhysicalState<T> physical_map(const PhysicalState<T>& s, const ModelMatrices& m, double g)
+{
+    return excursion(s, m, g).next;
+}
+
+// Result of G: the new canonical state and the multiplier lambda = v_{n+1}/v_n.
+template <class T>
+struct CanonicalStep {
+    CanonicalState<T> next;
+    T lambda;
+};
+
+// G: the physical map applied to the representative with v = 1, g = 1, then divided by
+// the new scale. For that representative x = 2 xi |U|, so the flight to the wall takes
+// t = 2 xi, reaches height y = 2 xi (1 - xi) and arrives with v_w = 1 - 2 xi; writing
+// these closed forms (rather than going through x) keeps G exact in xi near the
+// boundary planes xi -> 0 and xi -> 1. Valid for xi < 1; xi' is meaningful when U' < 0.
+template <class T>
+constexpr CanonicalStep<T> canonical_map(const CanonicalState<T>& c, const ModelMatrices& m)
+{
+    const T t_wall = 2.0 * c.xi;
+    const T y = t_wall * (1.0 - c.xi);
+    const Velocities<T> after_wall = wall_impact(Velocities<T>{c.U, 1.0 - t_wall, c.W}, m.wall);
+    const FloorArrival<T> f = flight_to_floor(after_wall, y, 1.0);
+    const Velocities<T> after_floor = floor_impact(Velocities<T>{after_wall.u, f.v_f, after_wall.W}, m.floor);
+    const T lambda = after_floor.v;
+    const T U = after_floor.u / lambda;
+    // xi' = g x' / (2 |u'| v') with g = 1; |u'| = -u' on the branch where it matters.
+    return {{f.x / (-2.0 * after_floor.u * lambda), U, after_floor.W / lambda}, lambda};
+}
+
+}  // namespace superball

@@ -1,0 +1,76 @@
+// Job files (SPEC.md section 4): what grid to explore, with which model, and where the
+// result goes.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/input.hpp"
+#include "core/model.hpp"
+#include "core/state.hpp"
+
+namespace superball {
+
+enum class Coordinates { canonical, physical };
+
+constexpr std::string_view name(Coordinates c) { return c == Coordinates::canonical ? "canonical" : "physical"; }
+
+// Names of the coordinates, in the order of result-file dimensions (SPEC.md section 5).
+std::vector<std::string> coordinate_names(Coordinates c);  // {"xi","U","W"} or {"x","u","v","omega"}
+
+// n cell-centred samples of [min, max].
+struct Range {
+    double min = 0.0;
+    double max = 0.0;
+    std::uint64_t n = 0;
+
+    // Sample i = min + (i + 0.5) (max - min) / n: cell centres, so the singular planes
+    // at the ends of a range are never sampled exactly. The one place this is computed.
+    double sample(std::uint64_t i) const { return min + (static_cast<double>(i) + 0.5) * (max - min) / static_cast<double>(n); }
+
+    friend bool operator==(const Range&, const Range&) = default;
+};
+
+// One coordinate of the grid: a fixed value or a range.
+struct Coordinate {
+    std::string name;
+    std::optional<double> fixed;  // set iff `range` is not
+    std::optional<Range> range;
+
+    bool is_range() const { return range.has_value(); }
+    friend bool operator==(const Coordinate&, const Coordinate&) = default;
+};
+
+struct Job {
+    Model model{};
+    Coordinates coordinates = Coordinates::canonical;
+    Frame frame{};                        // g and radius: physical grids only
+    std::vector<Coordinate> grid;         // every coordinate, in coordinate_names() order
+    std::uint32_t max_bounces = 1000;
+    std::string output;                   // [run] output, as written (may be empty: then the CLI must be given one)
+    std::optional<std::uint64_t> tile_points;  // [run] tile_points: target points per tile
+    std::string text;                     // the job file's text, stored in results
+
+    // The range axes, in order (1 to 3 of them).
+    std::vector<const Coordinate*> range_axes() const;
+    // Number of grid points (product of the range sizes).
+    std::uint64_t points() const;
+};
+
+// Parses and validates a job. `source` names the text in messages (usually the path).
+// Throws InputError naming the key, the value and what is accepted.
+Job parse_job(std::string_view text, std::string_view source);
+
+// Reads and parses a job file; a missing or unreadable file is an InputError too.
+Job load_job(const std::filesystem::path& path);
+
+// A canonical text of everything that determines the results (coordinates, grid, model,
+// g/radius, max_bounces) and nothing else (not the output path, comments or key order).
+// Resume refuses a file whose fingerprint differs.
+std::string fingerprint(const Job& job);
+
+}  // namespace superball

@@ -1,0 +1,54 @@
+// Small RAII layer over the MPI calls the explorer uses.
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace superball::mpi {
+
+// Turns an MPI error code into an exception (MPI_ERRORS_RETURN is set on the world
+// communicator by Environment).
+void check(int code, const char* what);
+
+// MPI_Init / MPI_Finalize for the lifetime of the object. One per process.
+class Environment {
+public:
+    Environment();
+    ~Environment();
+    Environment(const Environment&) = delete;
+    Environment& operator=(const Environment&) = delete;
+};
+
+// A communicator borrowed from MPI (not freed here).
+class Comm {
+public:
+    explicit Comm(MPI_Comm c) : comm_(c) {}
+    static Comm world() { return Comm(MPI_COMM_WORLD); }
+
+    MPI_Comm get() const { return comm_; }
+    int rank() const;
+    int size() const;
+    bool is_root() const { return rank() == 0; }
+
+    void barrier() const;
+    // Rank 0's value on every rank.
+    void broadcast(std::string& s) const;
+    void broadcast(std::vector<std::uint64_t>& v) const;
+    std::int64_t broadcast(std::int64_t x) const;
+    double broadcast(double x) const;
+    // Element-wise sum over ranks, result on every rank.
+    std::vector<std::uint64_t> sum(const std::vector<std::uint64_t>& v) const;
+
+    // Ends every process of the job: the only way out when one rank fails outside a
+    // collective operation.
+    [[noreturn]] void abort(int status) const;
+
+private:
+    MPI_Comm comm_;
+};
+
+}  // namespace superball::mpi

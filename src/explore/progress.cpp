@@ -1,0 +1,65 @@
+#include "progress.hpp"
+
+#include <fmt/core.h>
+#include <unistd.h>
+
+namespace superball {
+
+namespace {
+std::string duration_text(double s)
+{
+    if (!(s < 1e9)) return "?";
+    const auto t = static_cast<long long>(s + 0.5);
+    if (t >= 3600) return fmt::format("{}h{:02}m", t / 3600, (t % 3600) / 60);
+    if (t >= 60) return fmt::format("{}m{:02}s", t / 60, t % 60);
+    return fmt::format("{}s", t);
+}
+}  // namespace
+
+Progress::Progress(std::FILE* out, std::uint64_t total_tiles, std::uint64_t total_points, std::uint64_t already_tiles,
+                   std::uint64_t already_points)
+    : out_(out),
+      live_(isatty(fileno(out)) != 0),
+      total_tiles_(total_tiles),
+      total_points_(total_points),
+      tiles_done_(already_tiles),
+      points_done_(already_points)
+{
+}
+
+double Progress::seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+void Progress::tile_done(std::uint64_t points)
+{
+    ++tiles_done_;
+    points_done_ += points;
+    points_run_ += points;
+    const auto now = Clock::now();
+    // A terminal line can be redrawn often; a log gets a line every 10 s.
+    const auto interval = live_ ? std::chrono::milliseconds(200) : std::chrono::milliseconds(10000);
+    if (now - last_report_ >= interval) {
+        last_report_ = now;
+        report(false);
+    }
+}
+
+void Progress::report(bool final)
+{
+    const double s = seconds();
+    const double rate = s > 0 ? static_cast<double>(points_run_) / s : 0.0;
+    const double eta = rate > 0 ? static_cast<double>(total_points_ - points_done_) / rate : 1e18;
+    const std::string line = fmt::format("tiles {}/{} ({:.1f}%)  {:.3g} points/s  elapsed {}  ETA {}", tiles_done_,
+                                         total_tiles_, 100.0 * static_cast<double>(tiles_done_) / static_cast<double>(total_tiles_),
+                                         rate, duration_text(s), final ? "0s" : duration_text(eta));
+    if (live_) {
+        fmt::print(out_, "\r{:<90}", line);
+        if (final) fmt::print(out_, "\n");
+    } else {
+        fmt::print(out_, "{}\n", line);
+    }
+    std::fflush(out_);
+}
+
+void Progress::finish() { report(true); }
+
+}  // namespace superball

@@ -1,0 +1,51 @@
+// Cutting a grid into rectangular tiles. A tile is also the HDF5 chunk of the result,
+// so each tile is written in one piece.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace superball {
+
+using Extent = std::vector<std::uint64_t>;  // one entry per range axis, first axis slowest
+
+// A block of the grid: [start, start + count) along each axis.
+struct Box {
+    Extent start;
+    Extent count;
+
+    std::uint64_t points() const;
+};
+
+class Tiling {
+public:
+    // shape: grid points per axis; tile: points per axis of a full tile (clipped to shape).
+    Tiling(Extent shape, Extent tile);
+
+    const Extent& shape() const { return shape_; }
+    const Extent& tile_shape() const { return tile_; }
+    std::uint64_t tiles() const { return tiles_; }
+    std::uint64_t points() const;
+
+    // Tile t, row-major over the tiles; edge tiles are smaller.
+    Box box(std::uint64_t t) const;
+
+private:
+    Extent shape_;
+    Extent tile_;
+    Extent tiles_per_axis_;
+    std::uint64_t tiles_ = 0;
+};
+
+// A tile shape of about `target_points` points: the grid is halved along its currently
+// longest tile side until the tile is small enough, which keeps tiles near-cubic and
+// their sides powers-of-two fractions of the grid.
+Extent default_tile_shape(const Extent& shape, std::uint64_t target_points);
+
+// Target points per tile for `ranks` ranks: enough tiles (about 64 per rank) that the
+// dynamic schedule can balance very unequal costs, tiles big enough (>= 1024 points)
+// that one message and one HDF5 write are amortised, small enough (<= 16384) that a
+// rank's memory stays small.
+std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks);
+
+}  // namespace superball

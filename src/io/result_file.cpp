@@ -1,0 +1,221 @@
+#include "result_file.hpp"
+
+#include <algorithm>
+
+#include "superball/version.hpp"
+
+namespace superball {
+
+namespace {
+
+h5::Id mpio_access(const mpi::Comm& comm)
+{
+    h5::Id fapl = h5::plist_id(H5Pcreate(H5P_FILE_ACCESS), "H5Pcreate");
+    h5::check(H5Pset_fapl_mpio(fapl, comm.get(), MPI_INFO_NULL), "H5Pset_fapl_mpio");
+    // Metadata written by one rank, read by one rank and broadcast: the file's metadata
+    // is small and every rank touches the same.
+    h5::check(H5Pset_coll_metadata_write(fapl, true), "H5Pset_coll_metadata_write");
+    return fapl;
+}
+
+std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
+
+// A dataset whose chunks are the tiles, all allocated at creation (required for
+// independent parallel writes, and what keeps the metadata fixed during the run). No
+// fill: tile_done says which values are meaningful.
+h5::Id create_tiled(hid_t file, const char* name, hid_t type, const Tiling& tiling)
+{
+    const auto dims = to_hsize(tiling.shape());
+    const auto chunk = to_hsize(tiling.tile_shape());
+    const h5::Id space = h5::space_id(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), "H5Screate");
+    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
+    h5::check(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), "H5Pset_chunk");
+    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER), "H5Pset_fill_time");
+    return h5::dataset_id(H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
+}
+
+h5::Id create_1d(hid_t loc, const char* name, hid_t type, hsize_t n)
+{
+    const h5::Id space = h5::space_id(H5Screate_simple(1, &n, nullptr), "H5Screate");
+    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
+    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC), "H5Pset_fill_time");  // zeros: no tile done yet
+    return h5::dataset_id(H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
+}
+
+// Writes `data` over the hyperslab `box` of `dataset` (independent transfer).
+template <class T>
+void write_box(hid_t dataset, hid_t memtype, const Box& box, std::span<const T> data)
+{
+    const auto start = to_hsize(box.start);
+    const auto count = to_hsize(box.count);
+    const int rank = static_cast<int>(count.size());
+    const h5::Id mem = h5::space_id(H5Screate_simple(rank, count.data(), nullptr), "H5Screate");
+    const h5::Id file = h5::space_id(H5Dget_space(dataset), "H5Dget_space");
+    h5::check(H5Sselect_hyperslab(file, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), "H5Sselect_hyperslab");
+    h5::check(H5Dwrite(dataset, memtype, mem, file, H5P_DEFAULT, data.data()), "H5Dwrite");
+}
+
+Tiling tiling_of(hid_t file)
+{
+    const h5::Id d = h5::dataset_id(H5Dopen2(file, "/wall_bounces", H5P_DEFAULT), "open /wall_bounces");
+    const auto dims = h5::dataset_shape(d);
+    return Tiling(Extent(dims.begin(), dims.end()), h5::read_u64_vector_attribute(file, "tile_shape"));
+}
+
+}  // namespace
+
+ResultFile::ResultFile(h5::Id file, Tiling tiling)
+    : file_(std::move(file)),
+      wall_bounces_(h5::dataset_id(H5Dopen2(file_, "/wall_bounces", H5P_DEFAULT), "open /wall_bounces")),
+      outcome_(h5::dataset_id(H5Dopen2(file_, "/outcome", H5P_DEFAULT), "open /outcome")),
+      tile_done_(h5::dataset_id(H5Dopen2(file_, "/progress/tile_done", H5P_DEFAULT), "open /progress/tile_done")),
+      tiling_(std::move(tiling))
+{
+}
+
+ResultFile ResultFile::create(const std::filesystem::path& path, const mpi::Comm& comm, const Job& job, const Grid& grid,
+                              const Tiling& tiling)
+{
+    const h5::Id fapl = mpio_access(comm);
+    h5::Id file = h5::file_id(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), "create " + path.string());
+
+    // Counts never exceed max_bounces: 16 bits unless that is too few.
+    const hid_t count_type = job.max_bounces > 65535 ? H5T_STD_U32LE : H5T_STD_U16LE;
+    create_tiled(file, "/wall_bounces", count_type, tiling);
+    create_tiled(file, "/outcome", H5T_STD_U8LE, tiling);
+    {
+        const h5::Id progress = h5::group_id(H5Gcreate2(file, "/progress", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "/progress");
+        create_1d(progress, "tile_done", H5T_STD_U8LE, tiling.tiles());
+    }
+
+    const h5::Id axes = h5::group_id(H5Gcreate2(file, "/axes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "/axes");
+    std::vector<std::string> axis_names;
+    std::size_t k = 0;
+    for (const Coordinate& c : job.grid) {
+        if (!c.is_range()) {
+            h5::write_attribute(file, "fixed_" + c.name, *c.fixed);
+            continue;
+        }
+        axis_names.push_back(c.name);
+        const std::vector<double>& s = grid.samples(k++);
+        const h5::Id d = create_1d(axes, c.name.c_str(), H5T_IEEE_F64LE, s.size());
+        // Raw data: one rank writes it, the others take part in nothing.
+        if (comm.is_root()) {
+            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data()), "write axis " + c.name);
+        }
+    }
+
+    h5::write_attribute(file, "coordinates", std::string(name(job.coordinates)));
+    h5::write_attribute(file, "axis_names", axis_names);
+    h5::write_attribute(file, "e_wall", job.model.wall.e);
+    h5::write_attribute(file, "alpha_wall", job.model.wall.alpha);
+    h5::write_attribute(file, "e_floor", job.model.floor.e);
+    h5::write_attribute(file, "alpha_floor", job.model.floor.alpha);
+    if (job.coordinates == Coordinates::physical) {
+        h5::write_attribute(file, "g", job.frame.g);
+        h5::write_attribute(file, "radius", job.frame.radius);
+    }
+    h5::write_attribute(file, "max_bounces", static_cast<std::int64_t>(job.max_bounces));
+    h5::write_attribute(file, "job_toml", job.text);
+    h5::write_attribute(file, "job_fingerprint", fingerprint(job));
+    h5::write_attribute(file, "software_version", std::string(software_version));
+    h5::write_attribute(file, "tile_shape", tiling.tile_shape());
+    h5::write_attribute(file, "mpi_ranks", static_cast<std::int64_t>(comm.size()));
+    h5::write_attribute(file, "wall_seconds", 0.0);
+    h5::write_attribute(file, "complete", std::int64_t{0});
+    // From here on the metadata is final until finish(): make it durable before any tile.
+    h5::check(H5Fflush(file, H5F_SCOPE_GLOBAL), "H5Fflush");
+    return ResultFile(std::move(file), tiling);
+}
+
+ResultFile ResultFile::open(const std::filesystem::path& path, const mpi::Comm& comm)
+{
+    const h5::Id fapl = mpio_access(comm);
+    h5::Id file = h5::file_id(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl), "open " + path.string());
+    Tiling tiling = tiling_of(file);
+    return ResultFile(std::move(file), std::move(tiling));
+}
+
+std::vector<std::uint8_t> ResultFile::tiles_done() const
+{
+    std::vector<std::uint8_t> done(tiling_.tiles());
+    h5::check(H5Dread(tile_done_, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, done.data()), "read tile_done");
+    return done;
+}
+
+void ResultFile::write_tile(std::uint64_t tile, std::span<const std::uint32_t> wall_bounces,
+                            std::span<const std::uint8_t> outcomes)
+{
+    const Box box = tiling_.box(tile);
+    write_box(wall_bounces_, H5T_NATIVE_UINT32, box, wall_bounces);
+    write_box(outcome_, H5T_NATIVE_UINT8, box, outcomes);
+    const std::uint8_t one = 1;
+    write_box(tile_done_, H5T_NATIVE_UINT8, Box{{tile}, {1}}, std::span<const std::uint8_t>(&one, 1));
+}
+
+void ResultFile::finish(double run_seconds, int ranks, bool complete)
+{
+    const double before = h5::read_double_attribute(file_, "wall_seconds");
+    h5::write_attribute(file_, "wall_seconds", before + run_seconds);
+    h5::write_attribute(file_, "mpi_ranks", static_cast<std::int64_t>(ranks));
+    h5::write_attribute(file_, "complete", std::int64_t{complete ? 1 : 0});
+    wall_bounces_.close();
+    outcome_.close();
+    tile_done_.close();
+    file_.close();
+}
+
+ResultInfo read_result_info(const std::filesystem::path& path)
+{
+    const h5::Id file = h5::file_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open " + path.string());
+    ResultInfo info;
+    info.coordinates = h5::read_string_attribute(file, "coordinates");
+    info.job_toml = h5::read_string_attribute(file, "job_toml");
+    info.job_fingerprint = h5::read_string_attribute(file, "job_fingerprint");
+    info.software_version = h5::read_string_attribute(file, "software_version");
+    info.max_bounces = h5::read_int_attribute(file, "max_bounces");
+    info.mpi_ranks = h5::read_int_attribute(file, "mpi_ranks");
+    info.wall_seconds = h5::read_double_attribute(file, "wall_seconds");
+    info.complete = h5::read_int_attribute(file, "complete") != 0;
+    const Tiling tiling = tiling_of(file);
+    info.shape = tiling.shape();
+    info.tile_shape = tiling.tile_shape();
+    info.tiles = tiling.tiles();
+    {
+        const h5::Id d = h5::dataset_id(H5Dopen2(file, "/progress/tile_done", H5P_DEFAULT), "open /progress/tile_done");
+        std::vector<std::uint8_t> done(info.tiles);
+        h5::check(H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, done.data()), "read tile_done");
+        info.tiles_done = static_cast<std::uint64_t>(std::count(done.begin(), done.end(), std::uint8_t{1}));
+    }
+    info.axis_names = h5::read_string_vector_attribute(file, "axis_names");
+    return info;
+}
+
+std::vector<std::uint64_t> outcome_histogram(const std::filesystem::path& path)
+{
+    const h5::Id file = h5::file_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), "open " + path.string());
+    const h5::Id d = h5::dataset_id(H5Dopen2(file, "/outcome", H5P_DEFAULT), "open /outcome");
+    const auto dims = h5::dataset_shape(d);
+    hsize_t row = 1;
+    for (std::size_t k = 1; k < dims.size(); ++k) row *= dims[k];
+    // About 16 MiB at a time, whole rows along the first axis.
+    const hsize_t rows_per_block = std::max<hsize_t>(1, (hsize_t{1} << 24) / std::max<hsize_t>(row, 1));
+    std::vector<std::uint64_t> histogram(256, 0);
+    std::vector<std::uint8_t> buf;
+    const h5::Id file_space = h5::space_id(H5Dget_space(d), "H5Dget_space");
+    for (hsize_t first = 0; first < dims[0]; first += rows_per_block) {
+        std::vector<hsize_t> start(dims.size(), 0), count = dims;
+        start[0] = first;
+        count[0] = std::min(rows_per_block, dims[0] - first);
+        buf.resize(count[0] * row);
+        h5::check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr), "select");
+        const h5::Id mem = h5::space_id(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr), "mem");
+        h5::check(H5Dread(d, H5T_NATIVE_UINT8, mem, file_space, H5P_DEFAULT, buf.data()), "read /outcome");
+        for (const std::uint8_t o : buf) ++histogram[o];
+    }
+    return histogram;
+}
+
+}  // namespace superball

@@ -1,0 +1,80 @@
+// The result file of an exploration (SPEC.md section 5), written in parallel through
+// MPI-IO.
+//
+// Crash safety: every dataset is created with all its chunks allocated and the file is
+// flushed before any tile is computed, so from then on the file's metadata never
+// changes until the end of the run. A tile's data is written (pwrite through MPI-IO)
+// before its byte in /progress/tile_done, so a process killed at any moment leaves a
+// readable file in which every tile marked done holds its final data.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "explore/grid.hpp"
+#include "explore/job.hpp"
+#include "explore/mpi.hpp"
+#include "explore/tiles.hpp"
+#include "hdf5.hpp"
+
+namespace superball {
+
+// What a result file says about itself, read without MPI (rank 0 deciding whether to
+// resume, `superball info`).
+struct ResultInfo {
+    std::string coordinates;
+    std::vector<std::string> axis_names;
+    std::vector<std::uint64_t> shape;
+    std::vector<std::uint64_t> tile_shape;
+    std::string job_toml;
+    std::string job_fingerprint;
+    std::string software_version;
+    std::int64_t max_bounces = 0;
+    std::int64_t mpi_ranks = 0;
+    double wall_seconds = 0;
+    bool complete = false;
+    std::uint64_t tiles = 0;
+    std::uint64_t tiles_done = 0;
+};
+
+// Throws h5::Error if the file cannot be read as a superball result.
+ResultInfo read_result_info(const std::filesystem::path& path);
+
+// Outcome histogram of the whole file, read a block of rows at a time (serial).
+std::vector<std::uint64_t> outcome_histogram(const std::filesystem::path& path);
+
+class ResultFile {
+public:
+    // Collective: creates (or truncates) `path` with datasets, axes and attributes.
+    static ResultFile create(const std::filesystem::path& path, const mpi::Comm& comm, const Job& job, const Grid& grid,
+                             const Tiling& tiling);
+    // Collective: reopens a result for resume. Checking that it belongs to the job is the
+    // caller's business (read_result_info), done before.
+    static ResultFile open(const std::filesystem::path& path, const mpi::Comm& comm);
+
+    const Tiling& tiling() const { return tiling_; }
+    // Done flags of all tiles (independent read; every rank may call it).
+    std::vector<std::uint8_t> tiles_done() const;
+
+    // Independent: one tile's data, then its done flag.
+    void write_tile(std::uint64_t tile, std::span<const std::uint32_t> wall_bounces,
+                    std::span<const std::uint8_t> outcomes);
+
+    // Collective: run attributes, then close.
+    void finish(double run_seconds, int ranks, bool complete);
+
+private:
+    ResultFile(h5::Id file, Tiling tiling);
+
+    h5::Id file_;
+    h5::Id wall_bounces_;
+    h5::Id outcome_;
+    h5::Id tile_done_;
+    Tiling tiling_;
+};
+
+}  // namespace superball
