@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "core/count.hpp"
+#include "core/count_simd.hpp"
 #include "explore/grid.hpp"
 #include "explore/job.hpp"
 #include "explore/mpi.hpp"
@@ -28,6 +29,8 @@ struct ExploreOptions {
     bool resume = false;
     bool overwrite = false;
     bool quiet = false;
+    bool dry_run = false;
+    std::string kernel = "simd";
 };
 
 enum class Mode : std::int64_t { fresh, resume, complete, refuse };
@@ -91,6 +94,28 @@ void print_summary(const Job& job, const fs::path& out, const Progress& progress
     fmt::print(stderr, "result: {}\n", out.string());
 }
 
+// What --dry-run prints: the validated job, one `key: value` a line, for people and scripts.
+void print_plan(const Job& job, const fs::path& out, int ranks)
+{
+    fmt::print("job: valid\ncoordinates: {}\n", name(job.coordinates));
+    for (const Coordinate& c : job.grid) {
+        if (c.is_range()) {
+            fmt::print("axis {}: {} samples in [{}, {}]\n", c.name, c.range->n, c.range->min, c.range->max);
+        } else {
+            fmt::print("fixed {}: {}\n", c.name, *c.fixed);
+        }
+    }
+    fmt::print("model: e_wall {} alpha_wall {} e_floor {} alpha_floor {}\n", job.model.wall.e, job.model.wall.alpha,
+               job.model.floor.e, job.model.floor.alpha);
+    fmt::print("points: {}\nmax_bounces: {}\n", job.points(), job.max_bounces);
+    const std::uint64_t tile_points = job.tile_points.value_or(default_tile_points(job.points(), ranks));
+    const Tiling tiling(Grid(job).shape(), default_tile_shape(Grid(job).shape(), tile_points));
+    fmt::print("tiles: {} of up to {} points for {} rank{}\n", tiling.tiles(), tiling.box(0).points(), ranks,
+               ranks == 1 ? "" : "s");
+    std::error_code ec;
+    fmt::print("output: {}\noutput exists: {}\n", out.string(), fs::exists(out, ec) ? "yes" : "no");
+}
+
 int explore(const ExploreOptions& opt)
 {
     const mpi::Environment env;
@@ -101,6 +126,11 @@ int explore(const ExploreOptions& opt)
         const Job job = load_job(opt.job);
         const fs::path out = opt.output.empty() ? fs::path(job.output) : fs::path(opt.output);
         if (out.empty()) throw InputError("no output file: set [run] output in " + opt.job + " or give --output");
+
+        if (opt.dry_run) {
+            if (root) print_plan(job, out, world.size());
+            return 0;
+        }
 
         Decision d;
         if (root) {
@@ -140,7 +170,7 @@ int explore(const ExploreOptions& opt)
                            world.size() == 1 ? "" : "s");
             }
         }
-        Progress progress(stderr, tiling.tiles(), tiling.points(), done_tiles, done_points);
+        Progress progress(stderr, opt.quiet, tiling.tiles(), tiling.points(), done_tiles, done_points);
 
         const ModelMatrices matrices = ModelMatrices::of(job.model);
         std::vector<CanonicalState<double>> starts;
@@ -148,14 +178,15 @@ int explore(const ExploreOptions& opt)
         std::vector<std::uint8_t> outcomes;
         std::vector<std::uint64_t> histogram(outcome_count, 0);
         // Rank 0 answers requests this often (in points) while it computes.
-        constexpr std::size_t block = 256;
+        constexpr std::size_t block = 512;
+        const auto kernel = opt.kernel == "scalar" ? &count_each : &count_each_simd;
         const TileWork work = [&](std::uint64_t t, const Serve& serve) {
             grid.starts(tiling.box(t), starts);
             counts.resize(starts.size());
             outcomes.resize(starts.size());
             for (std::size_t i = 0; i < starts.size(); i += block) {
                 const std::size_t n = std::min(block, starts.size() - i);
-                count_each(std::span(starts).subspan(i, n), matrices, job.max_bounces, std::span(counts).subspan(i, n),
+                kernel(std::span(starts).subspan(i, n), matrices, job.max_bounces, std::span(counts).subspan(i, n),
                            std::span(outcomes).subspan(i, n));
                 serve();
             }
@@ -163,7 +194,7 @@ int explore(const ExploreOptions& opt)
             for (const std::uint8_t o : outcomes) ++histogram[o];
         };
         const TileDone on_done = [&](std::uint64_t t, int) {
-            if (!opt.quiet) progress.tile_done(tiling.box(t).points());
+            progress.tile_done(tiling.box(t).points());
         };
         const ScheduleResult r = run_schedule(world, std::move(pending), work, on_done, &StopSignals::requested);
 
@@ -171,7 +202,7 @@ int explore(const ExploreOptions& opt)
         file.finish(world.broadcast(progress.seconds()), world.size(), !r.interrupted);
         const std::vector<std::uint64_t> total = world.sum(histogram);
         if (root) {
-            if (!opt.quiet) progress.finish();
+            progress.finish();
             write_xdmf(out, read_result_info(out));
             print_summary(job, out, progress, total, !r.interrupted);
             if (r.interrupted) {
@@ -209,6 +240,10 @@ Runner add_explore_command(CLI::App& app)
     auto* overwrite = sub->add_flag("--overwrite", opt->overwrite, "replace an existing output file");
     sub->get_option("--resume")->excludes(overwrite);
     sub->add_flag("-q,--quiet", opt->quiet, "no progress lines");
+    sub->add_option("--kernel", opt->kernel, "counting kernel: simd (vectorised) or scalar; identical results")
+        ->check(CLI::IsMember({"simd", "scalar"}))
+        ->capture_default_str();
+    sub->add_flag("--dry-run", opt->dry_run, "check the job and print the plan (grid, tiles, output) without running");
     return [opt] { return explore(*opt); };
 }
 

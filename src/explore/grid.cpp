@@ -41,14 +41,22 @@ void Grid::starts(const Box& box, std::vector<CanonicalState<double>>& out) cons
     out.reserve(box.points());
     std::vector<double> coords = fixed_;
     const std::size_t d = samples_.size();
-    Extent index(d, 0);  // position inside the box, odometer-style
-    for (std::uint64_t p = 0, n = box.points(); p < n; ++p) {
-        for (std::size_t k = 0; k < d; ++k) coords[range_index_[k]] = samples_[k][box.start[k] + index[k]];
-        out.push_back(canonical(coords));
-        for (std::size_t k = d; k-- > 0;) {
+    const std::size_t last = d - 1;
+    const std::vector<double>& fastest = samples_[last];
+    // Odometer over every axis but the last; the last axis is the inner loop.
+    Extent index(d, 0);
+    for (;;) {
+        for (std::size_t k = 0; k < last; ++k) coords[range_index_[k]] = samples_[k][box.start[k] + index[k]];
+        for (std::uint64_t j = 0; j < box.count[last]; ++j) {
+            coords[range_index_[last]] = fastest[box.start[last] + j];
+            out.push_back(canonical(coords));
+        }
+        std::size_t k = last;
+        while (k-- > 0) {
             if (++index[k] < box.count[k]) break;
             index[k] = 0;
         }
+        if (k == static_cast<std::size_t>(-1)) return;
     }
 }
 

@@ -16,9 +16,10 @@ std::string duration_text(double s)
 }
 }  // namespace
 
-Progress::Progress(std::FILE* out, std::uint64_t total_tiles, std::uint64_t total_points, std::uint64_t already_tiles,
+Progress::Progress(std::FILE* out, bool quiet, std::uint64_t total_tiles, std::uint64_t total_points, std::uint64_t already_tiles,
                    std::uint64_t already_points)
     : out_(out),
+      quiet_(quiet),
       live_(isatty(fileno(out)) != 0),
       total_tiles_(total_tiles),
       total_points_(total_points),
@@ -34,6 +35,7 @@ void Progress::tile_done(std::uint64_t points)
     ++tiles_done_;
     points_done_ += points;
     points_run_ += points;
+    if (quiet_) return;
     const auto now = Clock::now();
     // A terminal line can be redrawn often; a log gets a line every 10 s.
     const auto interval = live_ ? std::chrono::milliseconds(200) : std::chrono::milliseconds(10000);
@@ -60,6 +62,9 @@ void Progress::report(bool final)
     std::fflush(out_);
 }
 
-void Progress::finish() { report(true); }
+void Progress::finish()
+{
+    if (!quiet_) report(true);
+}
 
 }  // namespace superball

@@ -12,7 +12,8 @@ namespace superball {
 class Progress {
 public:
     // total_*: the whole grid; already_*: done by earlier runs (resume).
-    Progress(std::FILE* out, std::uint64_t total_tiles, std::uint64_t total_points, std::uint64_t already_tiles,
+    // quiet: count, but print nothing.
+    Progress(std::FILE* out, bool quiet, std::uint64_t total_tiles, std::uint64_t total_points, std::uint64_t already_tiles,
              std::uint64_t already_points);
 
     // A tile of `points` points finished.
@@ -28,6 +29,7 @@ private:
 
     using Clock = std::chrono::steady_clock;
     std::FILE* out_;
+    bool quiet_;
     bool live_;
     std::uint64_t total_tiles_, total_points_;
     std::uint64_t tiles_done_, points_done_, points_run_ = 0;

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Runs a job on this machine: installs what is missing, builds if needed, explores with
+# one MPI rank per core, then draws the region map next to the result.
+#
+#   jobs/local.sh JOB.toml [superball explore options...]     e.g. --overwrite, --resume
+#
+# Environment: SUPERBALL_RANKS (default: number of cores), SUPERBALL_BUILD (build
+# directory, default build/native: optimised for this host's instruction set).
+set -euo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(dirname "$here")
+if [[ $# -lt 1 || "$1" == -h || "$1" == --help ]]; then
+  sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  exit $(( $# < 1 ? 2 : 0 ))
+fi
+job=$1; shift
+[[ -f "$job" ]] || { echo "local.sh: no job file $job" >&2; exit 2; }
+
+"$root/.ci/install-deps"
+build=${SUPERBALL_BUILD:-$root/build/native}
+if [[ ! -f "$build/CMakeCache.txt" ]]; then
+  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DSUPERBALL_NATIVE=ON -DSUPERBALL_TESTS=OFF \
+        -DSUPERBALL_BENCHMARKS=OFF >/dev/null
+fi
+cmake --build "$build" -j"$(nproc)" --target superball >/dev/null
+
+ranks=${SUPERBALL_RANKS:-$(nproc)}
+mpi_flags=()
+# Open MPI refuses to run as root unless told; only root needs this.
+if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
+(( ranks > $(nproc) )) && mpi_flags+=(--oversubscribe)
+
+# Checks the job before starting ranks, and learns where the result goes.
+output=$("$build/src/superball" explore "$job" "$@" --dry-run | sed -n 's/^output: \(.*\)$/\1/p')
+
+mpirun -n "$ranks" "${mpi_flags[@]}" "$build/src/superball" explore "$job" "$@"
+
+python=/usr/bin/python3
+[[ -x $python ]] || python=python3
+if [[ -n "$output" && -f "$root/analysis/region_map.py" ]]; then
+  "$python" "$root/analysis/region_map.py" "$output" -o "${output%.h5}.png"
+  echo "figure: ${output%.h5}.png"
+fi

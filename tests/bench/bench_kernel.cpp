@@ -1,0 +1,114 @@
+// Microbenchmarks of the map step and the counting kernels (Google Benchmark).
+//
+//   build/native/tests/bench/bench_kernel            (the native preset: -march=native)
+//
+// Reported: ns per map iteration (items = iterations of G) and points/s of the kernels
+// on the issue-4 slice U = -1, xi in (0, 1), W in [-3, 3], e = alpha = 0.9.
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <vector>
+
+#include "core/count.hpp"
+#include "core/count_simd.hpp"
+
+namespace {
+
+using namespace superball;
+
+const ModelMatrices slice_model = ModelMatrices::of(Model::uniform(0.9, 0.9));
+
+// n x n cell centres of the benchmark slice.
+std::vector<CanonicalState<double>> slice(std::size_t n)
+{
+    std::vector<CanonicalState<double>> s;
+    s.reserve(n * n);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t k = 0; k < n; ++k) {
+            s.push_back({(static_cast<double>(i) + 0.5) / static_cast<double>(n), -1.0,
+                         -3.0 + (static_cast<double>(k) + 0.5) * 6.0 / static_cast<double>(n)});
+        }
+    }
+    return s;
+}
+
+void BM_canonical_map(benchmark::State& state)
+{
+    // A chain of dependent steps from a state that stays in the region for long.
+    CanonicalState<double> c{0.05, -1.0, -2.0};
+    for (auto _ : state) {
+        const CanonicalStep<double> s = canonical_map(c, slice_model);
+        benchmark::DoNotOptimize(s);
+        c = {0.05 + 1e-3 * s.next.xi * 0.0, -1.0, -2.0};
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_canonical_map);
+
+void BM_physical_map(benchmark::State& state)
+{
+    const PhysicalState<double> s{0.02, -2.0, 2.0, -5.0};
+    for (auto _ : state) {
+        PhysicalState<double> in = s;
+        benchmark::DoNotOptimize(in);
+        benchmark::DoNotOptimize(physical_map(in, slice_model, 9.81));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_physical_map);
+
+template <bool simd>
+void BM_count_slice(benchmark::State& state)
+{
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const auto starts = slice(n);
+    std::vector<std::uint32_t> wb(starts.size());
+    std::vector<std::uint8_t> oc(starts.size());
+    for (auto _ : state) {
+        if constexpr (simd) {
+            count_each_simd(starts, slice_model, 1000, wb, oc);
+        } else {
+            count_each(starts, slice_model, 1000, wb, oc);
+        }
+        benchmark::ClobberMemory();
+    }
+    std::uint64_t iterations = 0;
+    for (const auto w : wb) iterations += w;
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * starts.size()));
+    state.counters["time_per_map_iteration"] = benchmark::Counter(
+        static_cast<double>(state.iterations() * iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK_TEMPLATE(BM_count_slice, false)->Arg(512)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_count_slice, true)->Arg(512)->Unit(benchmark::kMillisecond);
+
+// Long-lived points only (the region xi < 0.05, W < -2 of the slice, where counts are
+// highest): measures the arithmetic throughput of the kernels rather than lane refill.
+template <bool simd>
+void BM_count_long_lived(benchmark::State& state)
+{
+    std::vector<CanonicalState<double>> starts;
+    for (int i = 0; i < 64; ++i) {
+        for (int k = 0; k < 64; ++k) starts.push_back({0.0005 + 0.0007 * i, -1.0, -2.99 + 0.015 * k});
+    }
+    std::vector<std::uint32_t> wb(starts.size());
+    std::vector<std::uint8_t> oc(starts.size());
+    for (auto _ : state) {
+        if constexpr (simd) {
+            count_each_simd(starts, slice_model, 1000, wb, oc);
+        } else {
+            count_each(starts, slice_model, 1000, wb, oc);
+        }
+        benchmark::ClobberMemory();
+    }
+    std::uint64_t iterations = 0;
+    for (const auto w : wb) iterations += w;
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * starts.size()));
+    state.counters["time_per_map_iteration"] = benchmark::Counter(
+        static_cast<double>(state.iterations() * iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK_TEMPLATE(BM_count_long_lived, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_count_long_lived, true)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

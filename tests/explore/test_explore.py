@@ -1,0 +1,319 @@
+#!/usr/bin/python3
+"""End-to-end tests of `superball explore` under mpirun: results identical for every
+rank count and tile size and to `superball count` per point, the SPEC.md section 5
+layout read back with h5py, resume after SIGKILL, and refusal of bad jobs."""
+import json
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+SUPERBALL = os.environ.get("SUPERBALL", "superball")
+MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
+
+
+def mpi_env():
+    env = dict(os.environ)
+    if os.geteuid() == 0:  # Open MPI refuses root unless told
+        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    return env
+
+
+def descendants(pid):
+    """Every process below `pid`: Open MPI puts its ranks in process groups of their own,
+    so killing mpirun's group does not reach them."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(ppid, []).append(int(entry))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+def job_text(grid, model="e = 0.9\nalpha = 0.9", run="max_bounces = 1000"):
+    return f"[model]\n{model}\n\n[grid]\n{grid}\n\n[run]\n{run}\n"
+
+
+CANONICAL_2D = 'xi = { min = 0.0, max = 1.0, n = 61 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 47 }'
+
+
+class Explore(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="superball-explore-")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def write_job(self, text, name="job.toml"):
+        with open(self.path(name), "w") as f:
+            f.write(text)
+        return self.path(name)
+
+    def explore(self, job, output, ranks=1, extra=(), expect=0):
+        cmd = [MPIEXEC, "-n", str(ranks), "--oversubscribe", SUPERBALL, "explore", job, "-o", output, "-q", *extra]
+        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=300)
+        self.assertEqual(r.returncode, expect, f"{' '.join(cmd)}\nstdout:\n{r.stdout}\nstderr:\n{r.stderr}")
+        return r
+
+    @staticmethod
+    def datasets(path):
+        with h5py.File(path, "r") as f:
+            return f["wall_bounces"][()], f["outcome"][()]
+
+    def assert_same_results(self, a, b):
+        wa, oa = self.datasets(a)
+        wb, ob = self.datasets(b)
+        np.testing.assert_array_equal(wa, wb)
+        np.testing.assert_array_equal(oa, ob)
+
+    def test_identical_for_rank_counts_and_tile_sizes(self):
+        outputs = []
+        for ranks, tile in [(1, 64), (2, 64), (3, 64), (4, 64), (2, 7), (3, 1000), (1, 100000)]:
+            job = self.write_job(job_text(CANONICAL_2D, run=f"max_bounces = 1000\ntile_points = {tile}"),
+                                 f"job-{ranks}-{tile}.toml")
+            out = self.path(f"r{ranks}-t{tile}.h5")
+            self.explore(job, out, ranks)
+            outputs.append(out)
+            with h5py.File(out, "r") as f:
+                self.assertEqual(f.attrs["complete"], 1)
+                self.assertEqual(f.attrs["mpi_ranks"], ranks)
+                self.assertTrue(f["progress/tile_done"][()].all())
+        for out in outputs[1:]:
+            self.assert_same_results(outputs[0], out)
+
+    def test_equals_count_per_point(self):
+        """Every grid point equals `superball count` at the same coordinates (sampled)."""
+        job = self.write_job(job_text(CANONICAL_2D, model="e_wall = 0.8\nalpha_wall = 0.6\ne_floor = 0.85\nalpha_floor = 0.7"))
+        out = self.path("r.h5")
+        self.explore(job, out, 2)
+        wb, oc = self.datasets(out)
+        names = ["invalid", "left", "missed", "capped"]
+        rng = random.Random(7)
+        with h5py.File(out, "r") as f:
+            xi, W = f["axes/xi"][()], f["axes/W"][()]
+        for _ in range(60):
+            i, k = rng.randrange(len(xi)), rng.randrange(len(W))
+            r = subprocess.run([SUPERBALL, "count", "--json", "--e-wall", "0.8", "--alpha-wall", "0.6", "--e-floor", "0.85",
+                                "--alpha-floor", "0.7", "--xi", repr(float(xi[i])), "--U", "-1", "--W", repr(float(W[k]))],
+                               capture_output=True, text=True, check=True)
+            got = json.loads(r.stdout)
+            self.assertEqual((got["wall_bounces"], got["outcome"]), (int(wb[i, k]), names[oc[i, k]]), (xi[i], W[k]))
+
+    def test_layout(self):
+        job = self.write_job(job_text(CANONICAL_2D))
+        out = self.path("r.h5")
+        self.explore(job, out, 2)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f["wall_bounces"].dtype, np.uint16)
+            self.assertEqual(f["outcome"].dtype, np.uint8)
+            self.assertEqual(f["wall_bounces"].shape, (61, 47))
+            self.assertEqual(f["outcome"].shape, (61, 47))
+            self.assertEqual(f["wall_bounces"].chunks, f["outcome"].chunks)
+            self.assertEqual(sorted(f["axes"]), ["W", "xi"])
+            # Cell centres, computed as SPEC.md section 4 says.
+            expect = np.array([0.0 + (i + 0.5) * (1.0 - 0.0) / 61 for i in range(61)])
+            np.testing.assert_array_equal(f["axes/xi"][()], expect)
+            self.assertEqual(f["axes/W"].dtype, np.float64)
+            self.assertEqual(f["progress/tile_done"].dtype, np.uint8)
+            a = f.attrs
+            self.assertEqual(a["coordinates"], "canonical")
+            self.assertEqual(list(a["axis_names"]), ["xi", "W"])
+            for key in ["e_wall", "alpha_wall", "e_floor", "alpha_floor"]:
+                self.assertEqual(a[key], 0.9)
+            self.assertEqual(a["fixed_U"], -1.0)
+            self.assertEqual(a["max_bounces"], 1000)
+            self.assertIn("[grid]", a["job_toml"])
+            self.assertEqual(a["mpi_ranks"], 2)
+            self.assertGreater(a["wall_seconds"], 0)
+            self.assertEqual(a["complete"], 1)
+            self.assertTrue(a["software_version"])
+            self.assertNotIn("g", a)  # canonical grids have no g/radius
+            outcomes = set(np.unique(f["outcome"][()]))
+            self.assertTrue(outcomes <= {1, 2, 3})
+        xmf = ET.parse(self.path("r.xmf")).getroot()
+        topology = xmf.find(".//Topology")
+        self.assertEqual(topology.get("TopologyType"), "2DRectMesh")
+        self.assertEqual(topology.get("Dimensions"), "61 47")
+        h5dump = shutil.which("h5dump")
+        if h5dump:
+            r = subprocess.run([h5dump, "-H", out], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn('DATASET "wall_bounces"', r.stdout)
+
+    def test_three_dimensional_grid(self):
+        grid = ('xi = { min = 0.0, max = 1.0, n = 13 }\nU = { min = -2.0, max = -0.1, n = 9 }\n'
+                'W = { min = -3.0, max = 3.0, n = 11 }')
+        job = self.write_job(job_text(grid, run="max_bounces = 1000\ntile_points = 50"))
+        one, three = self.path("one.h5"), self.path("three.h5")
+        self.explore(job, one, 1)
+        self.explore(job, three, 3)
+        self.assert_same_results(one, three)
+        with h5py.File(one, "r") as f:
+            self.assertEqual(f["wall_bounces"].shape, (13, 9, 11))
+            self.assertEqual(list(f.attrs["axis_names"]), ["xi", "U", "W"])
+        self.assertEqual(ET.parse(self.path("one.xmf")).getroot().find(".//Topology").get("TopologyType"), "3DRectMesh")
+
+    def test_physical_grid(self):
+        grid = ('coordinates = "physical"\nx = { min = 0.0, max = 0.2, n = 30 }\nu = { min = -3.0, max = 1.0, n = 20 }\n'
+                'v = 2.0\nomega = -200.0')
+        job = self.write_job(job_text(grid, model="e = 0.9\nalpha = 0.9\ng = 9.81\nradius = 0.025"))
+        out = self.path("phys.h5")
+        self.explore(job, out, 2)
+        with h5py.File(out, "r") as f:
+            wb, oc = f["wall_bounces"][()], f["outcome"][()]
+            u = f["axes/u"][()]
+            self.assertEqual(f.attrs["coordinates"], "physical")
+            self.assertEqual(f.attrs["g"], 9.81)
+            self.assertEqual(f.attrs["radius"], 0.025)
+            self.assertEqual(f.attrs["fixed_v"], 2.0)
+            self.assertEqual(f.attrs["fixed_omega"], -200.0)
+        # u >= 0 is not a launch toward the wall: invalid, zero bounces.
+        self.assertTrue((oc[:, u >= 0] == 0).all())
+        self.assertTrue((wb[:, u >= 0] == 0).all())
+        self.assertTrue((oc[:, u < 0] != 0).all())
+        # The reference launch x = 0.02, u = -2, v = 2, omega = -200 gives 12 bounces, left;
+        # spot-check a grid point against `superball count` with the physical flags.
+        i, k = 3, int(np.argmin(abs(u + 2)))
+        with h5py.File(out, "r") as f:
+            x = f["axes/x"][i]
+        r = subprocess.run([SUPERBALL, "count", "--json", "--e", "0.9", "--alpha", "0.9", "--x", repr(float(x)), "--u",
+                            repr(float(u[k])), "--v", "2", "--omega", "-200"], capture_output=True, text=True, check=True)
+        self.assertEqual(json.loads(r.stdout)["wall_bounces"], int(wb[i, k]))
+
+    def test_one_axis_grid_and_wide_counts(self):
+        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 100 }\nU = -1.0\nW = -2.0',
+                                      model="e = 1.0\nalpha = 1.0", run="max_bounces = 70000"))
+        out = self.path("line.h5")
+        self.explore(job, out, 2)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f["wall_bounces"].shape, (100,))
+            self.assertEqual(f["wall_bounces"].dtype, np.uint32)  # max_bounces > 65535
+        self.assertFalse(os.path.exists(self.path("line.xmf")))
+
+    def test_refuses_to_overwrite(self):
+        job = self.write_job(job_text(CANONICAL_2D))
+        out = self.path("r.h5")
+        self.explore(job, out, 1)
+        with open(out, "rb") as f:
+            before = f.read()
+        r = self.explore(job, out, 1, expect=2)
+        self.assertIn("--overwrite", r.stderr)
+        with open(out, "rb") as f:
+            self.assertEqual(f.read(), before)
+        self.explore(job, out, 1, ["--overwrite"])
+        r = self.explore(job, out, 1, ["--resume"])  # complete: nothing to do
+        other = self.write_job(job_text(CANONICAL_2D.replace("n = 47", "n = 48")), "other.toml")
+        r = self.explore(other, out, 1, ["--resume"], expect=2)
+        self.assertIn("different job", r.stderr)
+
+    def test_resume_after_sigkill(self):
+        """A run killed with SIGKILL mid-way, then --resume, equals an uninterrupted run."""
+        # Conservative model: one point in eight bounces to the cap, so the run lasts a
+        # few seconds, long enough to be killed part-way.
+        grid = 'xi = { min = 0.0, max = 1.0, n = 300 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 300 }'
+        job = self.write_job(job_text(grid, model="e = 1.0\nalpha = 1.0", run="max_bounces = 20000\ntile_points = 400"))
+        out = self.path("killed.h5")
+        proc = subprocess.Popen([MPIEXEC, "-n", "2", "--oversubscribe", SUPERBALL, "explore", job, "-o", out, "-q"],
+                                env=mpi_env(), start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        reader_env = dict(os.environ, HDF5_USE_FILE_LOCKING="FALSE")
+        done, total = 0, 1
+        deadline = time.time() + 120
+        while time.time() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+            if not os.path.exists(out):
+                continue
+            r = subprocess.run([sys.executable, "-c",
+                                "import h5py,sys; d=h5py.File(sys.argv[1],'r')['progress/tile_done'][()]; print(d.sum(), d.size)",
+                                out], capture_output=True, text=True, env=reader_env)
+            if r.returncode == 0:
+                done, total = map(int, r.stdout.split())
+                if done >= total // 5:
+                    break
+        self.assertIsNone(proc.poll(), "the run finished before it could be killed: make the grid larger")
+        for pid in descendants(proc.pid) + [proc.pid]:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        proc.wait()
+        proc.stderr.close()
+        self.assertGreater(done, 0)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f.attrs["complete"], 0)
+            marked = int(f["progress/tile_done"][()].sum())
+            self.assertLess(marked, f["progress/tile_done"].size)
+        r = self.explore(job, out, 1, expect=2)  # an interrupted file is not overwritten either
+        self.assertIn("--resume", r.stderr)
+        self.explore(job, out, 2, ["--resume"])
+        reference = self.path("straight.h5")
+        self.explore(job, reference, 2)
+        self.assert_same_results(out, reference)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f.attrs["complete"], 1)
+
+
+class BadJobs(unittest.TestCase):
+    """Each class of job-file error: exit status 2, a message naming the key, no file."""
+
+    CASES = [
+        ("unknown key", job_text(CANONICAL_2D + "\nxii = 1.0"), "xii"),
+        ("missing coordinate", job_text('xi = { min = 0.0, max = 1.0, n = 4 }\nU = -1.0'), "W"),
+        ("wrong type", job_text(CANONICAL_2D.replace("U = -1.0", 'U = "minus one"')), "U"),
+        ("nan", job_text(CANONICAL_2D.replace("U = -1.0", "U = nan")), "U"),
+        ("min >= max", job_text(CANONICAL_2D.replace("max = 1.0", "max = 0.0")), "xi"),
+        ("n < 1", job_text(CANONICAL_2D.replace("n = 61", "n = 0")), "xi"),
+        ("e out of range", job_text(CANONICAL_2D, model="e = 1.5\nalpha = 0.9"), "e"),
+        ("alpha out of range", job_text(CANONICAL_2D, model="e = 0.9\nalpha = -2"), "alpha"),
+        ("syntax", "[model\ne = 0.9", "bad.toml:1:"),
+    ]
+
+    def test_bad_jobs(self):
+        d = tempfile.mkdtemp(prefix="superball-badjob-")
+        try:
+            for what, text, key in self.CASES:
+                with self.subTest(what):
+                    job = os.path.join(d, "bad.toml")
+                    with open(job, "w") as f:
+                        f.write(text)
+                    out = os.path.join(d, "out.h5")
+                    r = subprocess.run([SUPERBALL, "explore", job, "-o", out], capture_output=True, text=True,
+                                       env=mpi_env(), timeout=60)
+                    self.assertEqual(r.returncode, 2, r.stderr)
+                    self.assertIn(key, r.stderr)
+                    self.assertFalse(os.path.exists(out))
+            # Under mpirun with several ranks: still status 2, and one message, not one per rank.
+            r = subprocess.run([MPIEXEC, "-n", "3", "--oversubscribe", SUPERBALL, "explore", job, "-o", out],
+                               capture_output=True, text=True, env=mpi_env(), timeout=60)
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertEqual(r.stderr.count("superball explore:"), 1, r.stderr)
+            r = subprocess.run([SUPERBALL, "explore", os.path.join(d, "missing.toml")], capture_output=True, text=True,
+                               env=mpi_env())
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("missing.toml", r.stderr)
+        finally:
+            shutil.rmtree(d, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    unittest.main()
