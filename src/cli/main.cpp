@@ -37,8 +37,13 @@ int main(int argc, char** argv)
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        fmt::print(stderr, "superball: {}\n", e.what());
-        fmt::print(stderr, "Run with --help for usage.\n");
+        // CLI11 says "a subcommand is required" for a misspelt command: name it instead.
+        if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty()) {
+            fmt::print(stderr, "superball: unknown command '{}' (commands: explore, count, trajectory, info; see --help)\n",
+                       argv[1]);
+        } else {
+            fmt::print(stderr, "superball: {} (run with --help for usage)\n", e.what());
+        }
         return 2;
     }
     const CLI::App* chosen = app.get_subcommands().front();

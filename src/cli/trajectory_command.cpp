@@ -45,8 +45,8 @@ void write_json(std::FILE* f, const Trajectory& tr, const Start& start, const Mo
                m.wall.alpha, m.floor.e, m.floor.alpha);
     fmt::print(f, "  \"start\": {{\"xi\": {}, \"U\": {}, \"W\": {}}},\n", start.canonical.xi, start.canonical.U,
                start.canonical.W);
-    fmt::print(f, "  \"wall_bounces\": {}, \"outcome\": \"{}\",\n  \"events\": [", tr.result.wall_bounces,
-               name(tr.result.outcome));
+    fmt::print(f, "  \"wall_bounces\": {}, \"outcome\": \"{}\", \"events_truncated\": {},\n  \"events\": [",
+               tr.result.wall_bounces, name(tr.result.outcome), tr.truncated);
     const char* sep = "\n";
     for (const Event& e : tr.events) {
         fmt::print(f,
@@ -100,6 +100,12 @@ Runner add_trajectory_command(CLI::App& app)
             write_json(f, tr, start, model);
         } else {
             write_csv(f, tr, start.frame.radius);
+        }
+        if (tr.truncated) {
+            fmt::print(stderr,
+                       "superball trajectory: events stop after wall impact {}: the motion converges into the corner "
+                       "and its scale left double precision; the count ({} wall bounces, {}) is exact\n",
+                       tr.events.back().wall_bounces, tr.result.wall_bounces, name(tr.result.outcome));
         }
         return 0;
     };

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cmath>
+#include <experimental/simd>
 
 #include "impact.hpp"
 #include "state.hpp"
@@ -19,6 +20,16 @@ template <class T>
 T root(const T& x)
 {
     return sqrt(x);
+}
+
+// cond ? a : b, lane by lane for SIMD batches. Both branches are computed.
+inline double choose(bool cond, double a, double b) { return cond ? a : b; }
+template <class T, class Abi>
+std::experimental::simd<T, Abi> choose(const typename std::experimental::simd<T, Abi>::mask_type& cond,
+                                       std::experimental::simd<T, Abi> a, const std::experimental::simd<T, Abi>& b)
+{
+    std::experimental::where(!cond, a) = b;
+    return a;
 }
 }  // namespace detail
 
@@ -45,12 +56,17 @@ struct FloorArrival {
     T v_f;  // vertical velocity on arrival, -sqrt(v+^2 + 2 g y)
 };
 
+//
+// T = (v+ - v_f)/g = (v+ + s)/g with s = sqrt(v+^2 + 2 g y). When the ball comes off the
+// wall going down (v+ < 0) from low down (small y), v+ + s cancels: the same quantity is
+// then computed as 2 y / (s - v+), which has no cancellation for v+ < 0. Near the plane
+// xi -> 0 this keeps x_{n+1} (hence xi') accurate to rounding instead of losing digits.
 template <class T>
 constexpr FloorArrival<T> flight_to_floor(const Velocities<T>& after_wall, const T& y, double g)
 {
-    const T v_f = -detail::root(after_wall.v * after_wall.v + 2.0 * g * y);
-    const T t = (after_wall.v - v_f) / g;
-    return {t, after_wall.u * t, v_f};
+    const T s = detail::root(after_wall.v * after_wall.v + 2.0 * g * y);
+    const T t = detail::choose(after_wall.v >= 0.0, (after_wall.v + s) / g, 2.0 * y / (s - after_wall.v));
+    return {t, after_wall.u * t, -s};
 }
 
 // Everything an excursion produces; the physical map F is its `next` state.
@@ -91,8 +107,10 @@ struct CanonicalStep {
 // G: the physical map applied to the representative with v = 1, g = 1, then divided by
 // the new scale. For that representative x = 2 xi |U|, so the flight to the wall takes
 // t = 2 xi, reaches height y = 2 xi (1 - xi) and arrives with v_w = 1 - 2 xi; writing
-// these closed forms (rather than going through x) keeps G exact in xi near the
-// boundary planes xi -> 0 and xi -> 1. Valid for xi < 1; xi' is meaningful when U' < 0.
+// these closed forms (rather than going through x) avoids the rounding of x/u, and the
+// flight back is computed without cancellation (flight_to_floor), so G keeps full
+// relative precision near the boundary planes xi -> 0 and xi -> 1. Valid for xi < 1;
+// xi' is meaningful when U' < 0.
 template <class T>
 constexpr CanonicalStep<T> canonical_map(const CanonicalState<T>& c, const ModelMatrices& m)
 {

@@ -48,7 +48,7 @@ Trajectory trajectory(const PhysicalState<double>& start, const Model& model, do
     out.events.push_back({EventKind::launch, 0, 0.0, s.x, 0.0, v0, v0});
     for (;;) {
         if (!(c.xi < 1.0)) {
-            land(s, t, n);
+            if (!out.truncated) land(s, t, n);
             out.result = {n, Outcome::missed};
             return out;
         }
@@ -56,21 +56,23 @@ Trajectory trajectory(const PhysicalState<double>& start, const Model& model, do
             out.result = {n, Outcome::capped};
             return out;
         }
-        const Excursion<double> e = excursion(s, m, g);
-        flight(e.to_wall.t);
-        t += e.to_wall.t;
+        // Past the representable scale only the canonical state goes on, for the result.
+        out.truncated = out.truncated || s.v < start.v * representable_scale;
         ++n;
-        out.events.push_back(
-            {EventKind::wall, n, t, 0.0, e.to_wall.y, {s.u, e.to_wall.v_w, s.W}, e.after_wall});
-        flight(e.to_floor.t);
-        t += e.to_floor.t;
-        out.events.push_back({EventKind::floor, n, t, e.next.x, 0.0,
-                              {e.after_wall.u, e.to_floor.v_f, e.after_wall.W},
-                              {e.next.u, e.next.v, e.next.W}});
-        s = e.next;
+        if (!out.truncated) {
+            const Excursion<double> e = excursion(s, m, g);
+            flight(e.to_wall.t);
+            t += e.to_wall.t;
+            out.events.push_back({EventKind::wall, n, t, 0.0, e.to_wall.y, {s.u, e.to_wall.v_w, s.W}, e.after_wall});
+            flight(e.to_floor.t);
+            t += e.to_floor.t;
+            out.events.push_back({EventKind::floor, n, t, e.next.x, 0.0,
+                                  {e.after_wall.u, e.to_floor.v_f, e.after_wall.W}, {e.next.u, e.next.v, e.next.W}});
+            s = e.next;
+        }
         c = canonical_map(c, m).next;
         if (c.U >= 0.0) {
-            land(s, t, n);
+            if (!out.truncated) land(s, t, n);
             out.result = {n, Outcome::left};
             return out;
         }

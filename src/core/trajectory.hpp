@@ -46,7 +46,15 @@ struct Trajectory {
     std::vector<Event> events;
     std::vector<PathPoint> path;  // empty unless samples were asked for
     BounceCount result;
+    // The events stop early when the motion has shrunk by more than `representable_scale`
+    // (vertical speed relative to the launch's): a motion that converges into the corner
+    // would otherwise underflow to 0 and NaN. `result` is exact all the same.
+    bool truncated = false;
 };
+
+// Vertical speed ratio v_n / v_0 below which trajectory() stops recording events:
+// lengths scale as its square, 1e-200, still far from underflow.
+inline constexpr double representable_scale = 1e-100;
 
 // Follows a physical launch through its impacts. The decisions (miss, leave, cap) are
 // taken on the canonical state iterated alongside, so the result always equals
