@@ -173,7 +173,7 @@ int explore(const ExploreOptions& opt)
         Progress progress(stderr, opt.quiet, tiling.tiles(), tiling.points(), done_tiles, done_points);
 
         const ModelMatrices matrices = ModelMatrices::of(job.model);
-        std::vector<CanonicalState<double>> starts;
+        Starts starts;
         std::vector<std::uint32_t> counts;
         std::vector<std::uint8_t> outcomes;
         std::vector<std::uint64_t> histogram(outcome_count, 0);
@@ -186,7 +186,7 @@ int explore(const ExploreOptions& opt)
             outcomes.resize(starts.size());
             for (std::size_t i = 0; i < starts.size(); i += block) {
                 const std::size_t n = std::min(block, starts.size() - i);
-                kernel(std::span(starts).subspan(i, n), matrices, job.max_bounces, std::span(counts).subspan(i, n),
+                kernel(starts.view().subview(i, n), matrices, job.max_bounces, std::span(counts).subspan(i, n),
                            std::span(outcomes).subspan(i, n));
                 serve();
             }

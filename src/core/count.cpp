@@ -29,7 +29,7 @@ BounceCount count(const CanonicalState<double>& start, const ModelMatrices& m, s
     }
 }
 
-void count_each(std::span<const CanonicalState<double>> starts, const ModelMatrices& m, std::uint32_t max_bounces,
+void count_each(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                 std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
 {
     for (std::size_t i = 0; i < starts.size(); ++i) {

@@ -5,6 +5,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "map.hpp"
 
@@ -50,9 +51,47 @@ inline BounceCount count(const CanonicalState<double>& start, const Model& m, st
     return count(start, ModelMatrices::of(m), max_bounces);
 }
 
+// Many canonical starts, one array per coordinate: the layout from which the vectorised
+// kernel loads whole batches.
+struct StartsView {
+    std::span<const double> xi, U, W;
+
+    std::size_t size() const { return xi.size(); }
+    CanonicalState<double> operator[](std::size_t i) const { return {xi[i], U[i], W[i]}; }
+    StartsView subview(std::size_t first, std::size_t n) const
+    {
+        return {xi.subspan(first, n), U.subspan(first, n), W.subspan(first, n)};
+    }
+};
+
+struct Starts {
+    std::vector<double> xi, U, W;
+
+    std::size_t size() const { return xi.size(); }
+    void clear()
+    {
+        xi.clear();
+        U.clear();
+        W.clear();
+    }
+    void reserve(std::size_t n)
+    {
+        xi.reserve(n);
+        U.reserve(n);
+        W.reserve(n);
+    }
+    void push_back(const CanonicalState<double>& c)
+    {
+        xi.push_back(c.xi);
+        U.push_back(c.U);
+        W.push_back(c.W);
+    }
+    StartsView view() const { return {xi, U, W}; }
+};
+
 // count() of every start: wall_bounces[i], outcome[i] for starts[i]. The batch form the
-// explorer calls per block of a tile (and the entry point of the vectorised kernel).
-void count_each(std::span<const CanonicalState<double>> starts, const ModelMatrices& m, std::uint32_t max_bounces,
+// explorer calls per block of a tile; count_each_simd() is its vectorised twin.
+void count_each(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                 std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes);
 
 // Physical start: converted to canonical coordinates; not a launch -> invalid.

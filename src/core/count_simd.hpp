@@ -20,7 +20,7 @@ namespace superball {
 // Same contract as count_each(), results identical to it. Lane refill: when a point
 // leaves, misses or is capped, its lane takes the next point of the input at once, so
 // one long-lived point never holds the other lanes idle.
-void count_each_simd(std::span<const CanonicalState<double>> starts, const ModelMatrices& m, std::uint32_t max_bounces,
+void count_each_simd(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                      std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes);
 
 // Number of lanes of the kernel in this build.

@@ -14,16 +14,23 @@
 namespace superball {
 
 namespace detail {
-// sqrt that finds the SIMD overload by argument-dependent lookup.
+// sqrt that finds the SIMD (or automatic-differentiation) overload by argument-dependent
+// lookup. `auto`: for expression-template number types sqrt returns another type.
 using std::sqrt;
 template <class T>
-T root(const T& x)
+auto root(const T& x)
 {
     return sqrt(x);
 }
 
 // cond ? a : b, lane by lane for SIMD batches. Both branches are computed.
 inline double choose(bool cond, double a, double b) { return cond ? a : b; }
+// Other scalar number types (automatic differentiation in dynamics.hpp).
+template <class T>
+T choose(bool cond, const T& a, const T& b)
+{
+    return cond ? a : b;
+}
 template <class T, class Abi>
 std::experimental::simd<T, Abi> choose(const typename std::experimental::simd<T, Abi>::mask_type& cond,
                                        std::experimental::simd<T, Abi> a, const std::experimental::simd<T, Abi>& b)
@@ -65,7 +72,8 @@ template <class T>
 constexpr FloorArrival<T> flight_to_floor(const Velocities<T>& after_wall, const T& y, double g)
 {
     const T s = detail::root(after_wall.v * after_wall.v + 2.0 * g * y);
-    const T t = detail::choose(after_wall.v >= 0.0, (after_wall.v + s) / g, 2.0 * y / (s - after_wall.v));
+    // T(...): both branches of the same type even when T's arithmetic yields expression types.
+    const T t = detail::choose(after_wall.v >= 0.0, T((after_wall.v + s) / g), T(2.0 * y / (s - after_wall.v)));
     return {t, after_wall.u * t, -s};
 }
 

@@ -35,7 +35,7 @@ CanonicalState<double> Grid::canonical(const std::vector<double>& c) const
     return to_canonical(s, frame_.g);
 }
 
-void Grid::starts(const Box& box, std::vector<CanonicalState<double>>& out) const
+void Grid::starts(const Box& box, Starts& out) const
 {
     out.clear();
     out.reserve(box.points());

@@ -4,7 +4,7 @@
 #include <span>
 #include <vector>
 
-#include "core/state.hpp"
+#include "core/count.hpp"
 #include "job.hpp"
 #include "tiles.hpp"
 
@@ -22,7 +22,7 @@ public:
     // The canonical start of every point of `box`, row-major (last axis fastest).
     // Physical points that are not a launch toward the wall become a non-admissible
     // canonical state (NaN), which count() reports as invalid.
-    void starts(const Box& box, std::vector<CanonicalState<double>>& out) const;
+    void starts(const Box& box, Starts& out) const;
 
 private:
     CanonicalState<double> canonical(const std::vector<double>& coords) const;

@@ -16,6 +16,13 @@ namespace {
 
 using namespace superball;
 
+Starts soa(const std::vector<CanonicalState<double>>& s)
+{
+    Starts out;
+    for (const auto& c : s) out.push_back(c);
+    return out;
+}
+
 const ModelMatrices slice_model = ModelMatrices::of(Model::uniform(0.9, 0.9));
 
 // n x n cell centres of the benchmark slice.
@@ -64,11 +71,12 @@ void BM_count_slice(benchmark::State& state)
     const auto starts = slice(n);
     std::vector<std::uint32_t> wb(starts.size());
     std::vector<std::uint8_t> oc(starts.size());
+    const Starts points = soa(starts);
     for (auto _ : state) {
         if constexpr (simd) {
-            count_each_simd(starts, slice_model, 1000, wb, oc);
+            count_each_simd(points.view(), slice_model, 1000, wb, oc);
         } else {
-            count_each(starts, slice_model, 1000, wb, oc);
+            count_each(points.view(), slice_model, 1000, wb, oc);
         }
         benchmark::ClobberMemory();
     }
@@ -92,11 +100,12 @@ void BM_count_long_lived(benchmark::State& state)
     }
     std::vector<std::uint32_t> wb(starts.size());
     std::vector<std::uint8_t> oc(starts.size());
+    const Starts points = soa(starts);
     for (auto _ : state) {
         if constexpr (simd) {
-            count_each_simd(starts, slice_model, 1000, wb, oc);
+            count_each_simd(points.view(), slice_model, 1000, wb, oc);
         } else {
-            count_each(starts, slice_model, 1000, wb, oc);
+            count_each(points.view(), slice_model, 1000, wb, oc);
         }
         benchmark::ClobberMemory();
     }
