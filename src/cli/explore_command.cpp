@@ -1,6 +1,8 @@
 #include <fmt/core.h>
+#include <sys/resource.h>
 
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 
@@ -77,8 +79,16 @@ Decision decide(const ExploreOptions& opt, const fs::path& out, const Job& job)
     return {Mode::resume, fmt::format("resuming {}: {} of {} tiles already done", out.string(), info.tiles_done, info.tiles)};
 }
 
+// Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
+double peak_rss_mib()
+{
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
 void print_summary(const Job& job, const fs::path& out, const Progress& progress,
-                   const std::vector<std::uint64_t>& histogram, bool complete)
+                   const std::vector<std::uint64_t>& histogram, bool complete, double peak_mib)
 {
     const double s = progress.seconds();
     const auto n = progress.points_this_run();
@@ -91,6 +101,7 @@ void print_summary(const Job& job, const fs::path& out, const Progress& progress
                             100.0 * frac);
     }
     fmt::print(stderr, "{}\n", line);
+    fmt::print(stderr, "peak memory per rank: {:.1f} MiB (largest rank)\n", peak_mib);
     fmt::print(stderr, "result: {}\n", out.string());
 }
 
@@ -118,6 +129,7 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
 
 int explore(const ExploreOptions& opt)
 {
+    const auto started = std::chrono::steady_clock::now();
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
     const bool root = world.is_root();
@@ -198,13 +210,15 @@ int explore(const ExploreOptions& opt)
         };
         const ScheduleResult r = run_schedule(world, std::move(pending), work, on_done, &StopSignals::requested);
 
+        if (root) progress.finish();
         // Attributes are written collectively and must be identical on every rank.
-        file.finish(world.broadcast(progress.seconds()), world.size(), !r.interrupted);
+        const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        file.finish(world.broadcast(run_seconds), world.size(), !r.interrupted);
         const std::vector<std::uint64_t> total = world.sum(histogram);
+        const double peak_mib = world.max(peak_rss_mib());
         if (root) {
-            progress.finish();
             write_xdmf(out, read_result_info(out));
-            print_summary(job, out, progress, total, !r.interrupted);
+            print_summary(job, out, progress, total, !r.interrupted, peak_mib);
             if (r.interrupted) {
                 fmt::print(stderr, "stopped by a signal: {} is consistent and incomplete; run the same command with "
                                    "--resume to finish it\n",

@@ -80,6 +80,18 @@ struct Starts {
         U.reserve(n);
         W.reserve(n);
     }
+    void resize(std::size_t n)
+    {
+        xi.resize(n);
+        U.resize(n);
+        W.resize(n);
+    }
+    void set(std::size_t i, const CanonicalState<double>& c)
+    {
+        xi[i] = c.xi;
+        U[i] = c.U;
+        W[i] = c.W;
+    }
     void push_back(const CanonicalState<double>& c)
     {
         xi.push_back(c.xi);

@@ -1,5 +1,6 @@
 #include "grid.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace superball {
@@ -37,19 +38,36 @@ CanonicalState<double> Grid::canonical(const std::vector<double>& c) const
 
 void Grid::starts(const Box& box, Starts& out) const
 {
-    out.clear();
-    out.reserve(box.points());
+    out.resize(box.points());
     std::vector<double> coords = fixed_;
     const std::size_t d = samples_.size();
     const std::size_t last = d - 1;
-    const std::vector<double>& fastest = samples_[last];
+    const double* fastest = samples_[last].data() + box.start[last];
+    double& varying = coords[range_index_[last]];
+    std::size_t p = 0;
     // Odometer over every axis but the last; the last axis is the inner loop.
     Extent index(d, 0);
     for (;;) {
         for (std::size_t k = 0; k < last; ++k) coords[range_index_[k]] = samples_[k][box.start[k] + index[k]];
-        for (std::uint64_t j = 0; j < box.count[last]; ++j) {
-            coords[range_index_[last]] = fastest[box.start[last] + j];
-            out.push_back(canonical(coords));
+        const std::uint64_t row = box.count[last];
+        if (coordinates_ == Coordinates::canonical) {
+            // A row of canonical starts is two constant arrays and one copied axis: no
+            // per-point work (this loop was 10% of a run when done point by point).
+            std::vector<double>* arrays[] = {&out.xi, &out.U, &out.W};
+            for (std::size_t c = 0; c < 3; ++c) {
+                double* dst = arrays[c]->data() + p;
+                if (c == range_index_[last]) {
+                    std::copy(fastest, fastest + row, dst);
+                } else {
+                    std::fill(dst, dst + row, coords[c]);
+                }
+            }
+            p += row;
+        } else {
+            for (std::uint64_t j = 0; j < row; ++j) {
+                varying = fastest[j];
+                out.set(p++, canonical(coords));
+            }
         }
         std::size_t k = last;
         while (k-- > 0) {

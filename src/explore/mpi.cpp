@@ -66,6 +66,13 @@ std::vector<std::uint64_t> Comm::sum(const std::vector<std::uint64_t>& v) const
     return out;
 }
 
+double Comm::max(double x) const
+{
+    double out = 0;
+    check(MPI_Allreduce(&x, &out, 1, MPI_DOUBLE, MPI_MAX, comm_), "MPI_Allreduce");
+    return out;
+}
+
 double Comm::broadcast(double x) const
 {
     check(MPI_Bcast(&x, 1, MPI_DOUBLE, 0, comm_), "MPI_Bcast");

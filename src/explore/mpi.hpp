@@ -42,6 +42,8 @@ public:
     double broadcast(double x) const;
     // Element-wise sum over ranks, result on every rank.
     std::vector<std::uint64_t> sum(const std::vector<std::uint64_t>& v) const;
+    // Largest value over ranks, on every rank.
+    double max(double x) const;
 
     // Ends every process of the job: the only way out when one rank fails outside a
     // collective operation.

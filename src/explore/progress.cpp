@@ -28,7 +28,10 @@ Progress::Progress(std::FILE* out, bool quiet, std::uint64_t total_tiles, std::u
 {
 }
 
-double Progress::seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+double Progress::seconds() const
+{
+    return std::chrono::duration<double>((stopped_ ? stop_ : Clock::now()) - start_).count();
+}
 
 void Progress::tile_done(std::uint64_t points)
 {
@@ -64,6 +67,8 @@ void Progress::report(bool final)
 
 void Progress::finish()
 {
+    stop_ = Clock::now();
+    stopped_ = true;
     if (!quiet_) report(true);
 }
 

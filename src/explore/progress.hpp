@@ -18,9 +18,10 @@ public:
 
     // A tile of `points` points finished.
     void tile_done(std::uint64_t points);
-    // Ends the live line.
+    // Stops the clock and ends the live line.
     void finish();
 
+    // Seconds from construction to finish() (or to now, before it).
     double seconds() const;
     std::uint64_t points_this_run() const { return points_run_; }
 
@@ -35,6 +36,8 @@ private:
     std::uint64_t tiles_done_, points_done_, points_run_ = 0;
     Clock::time_point start_ = Clock::now();
     Clock::time_point last_report_ = start_;
+    Clock::time_point stop_{};
+    bool stopped_ = false;
 };
 
 }  // namespace superball

@@ -15,6 +15,10 @@ h5::Id mpio_access(const mpi::Comm& comm)
     // Metadata written by one rank, read by one rank and broadcast: the file's metadata
     // is small and every rank touches the same.
     h5::check(H5Pset_coll_metadata_write(fapl, true), "H5Pset_coll_metadata_write");
+    // HDF5 1.10 format: chunks of a fixed-size dataset are indexed by a fixed array
+    // instead of a B-tree, whose in-memory cost grew with the number of tiles (measured:
+    // +12 MiB per rank for 16384 tiles). h5py, h5dump and ParaView read it.
+    h5::check(H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_LATEST), "H5Pset_libver_bounds");
     return fapl;
 }
 
@@ -73,6 +77,8 @@ ResultFile::ResultFile(h5::Id file, Tiling tiling)
       tile_done_(h5::dataset_id(H5Dopen2(file_, "/progress/tile_done", H5P_DEFAULT), "open /progress/tile_done")),
       tiling_(std::move(tiling))
 {
+    const h5::Id type = h5::type_id(H5Dget_type(wall_bounces_), "H5Dget_type");
+    narrow_counts_ = H5Tget_size(type) == 2;
 }
 
 ResultFile ResultFile::create(const std::filesystem::path& path, const mpi::Comm& comm, const Job& job, const Grid& grid,
@@ -149,7 +155,13 @@ void ResultFile::write_tile(std::uint64_t tile, std::span<const std::uint32_t> w
                             std::span<const std::uint8_t> outcomes)
 {
     const Box box = tiling_.box(tile);
-    write_box(wall_bounces_, H5T_NATIVE_UINT32, box, wall_bounces);
+    if (narrow_counts_) {
+        // Counts never exceed max_bounces <= 65535 in a 16-bit file.
+        narrow_.assign(wall_bounces.begin(), wall_bounces.end());
+        write_box(wall_bounces_, H5T_NATIVE_UINT16, box, std::span<const std::uint16_t>(narrow_));
+    } else {
+        write_box(wall_bounces_, H5T_NATIVE_UINT32, box, wall_bounces);
+    }
     write_box(outcome_, H5T_NATIVE_UINT8, box, outcomes);
     const std::uint8_t one = 1;
     write_box(tile_done_, H5T_NATIVE_UINT8, Box{{tile}, {1}}, std::span<const std::uint8_t>(&one, 1));
