@@ -113,7 +113,11 @@ def new_figure(size, dpi, **kwargs):
 
 
 def format_number(value):
-    """Short text of a number for titles and tables (6 significant digits)."""
+    """Short text of a number for titles and tables (6 significant digits). A swept
+    coefficient's attribute is a text naming its axis ("axis:alpha"), shown as it is."""
+    value = decode(value)
+    if isinstance(value, str):
+        return value
     return f"{value:.6g}"
 
 

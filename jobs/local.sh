@@ -38,6 +38,14 @@ mpirun -n "$ranks" "${mpi_flags[@]}" "$build/src/superball" explore "$job" "$@"
 python=/usr/bin/python3
 [[ -x $python ]] || python=python3
 if [[ -n "$output" && -f "$root/analysis/region_map.py" ]]; then
-  "$python" "$root/analysis/region_map.py" "$output" -o "${output%.h5}.png"
+  # A 3-D (or 4-D) result is drawn at the middle of its leading axes; region_map.py
+  # --slice draws any other slice.
+  slices=$("$python" -c '
+import sys, h5py
+with h5py.File(sys.argv[1], "r") as f:
+    names, shape = list(f.attrs["axis_names"]), f["wall_bounces"].shape
+print(" ".join(f"--slice {n}={s // 2}" for n, s in zip(names, shape[:max(len(shape) - 2, 0)])))' "$output")
+  # shellcheck disable=SC2086  # $slices is a list of options
+  "$python" "$root/analysis/region_map.py" "$output" $slices -o "${output%.h5}.png"
   echo "figure: ${output%.h5}.png"
 fi

@@ -13,6 +13,7 @@
 #include "explore/job.hpp"
 #include "explore/mpi.hpp"
 #include "explore/progress.hpp"
+#include "explore/refine.hpp"
 #include "explore/schedule.hpp"
 #include "explore/signals.hpp"
 #include "io/result_file.hpp"
@@ -119,8 +120,8 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
     fmt::print("model: e_wall {} alpha_wall {} e_floor {} alpha_floor {}\n", job.model.wall.e, job.model.wall.alpha,
                job.model.floor.e, job.model.floor.alpha);
     fmt::print("points: {}\nmax_bounces: {}\n", job.points(), job.max_bounces);
-    const std::uint64_t tile_points = job.tile_points.value_or(default_tile_points(job.points(), ranks));
-    const Tiling tiling(Grid(job).shape(), default_tile_shape(Grid(job).shape(), tile_points));
+    if (job.refine != 0) fmt::print("refine: coarse stride {}\n", job.refine);
+    const Tiling tiling = default_tiling(job, ranks);
     fmt::print("tiles: {} of up to {} points for {} rank{}\n", tiling.tiles(), tiling.box(0).points(), ranks,
                ranks == 1 ? "" : "s");
     std::error_code ec;
@@ -157,11 +158,8 @@ int explore(const ExploreOptions& opt)
 
         const StopSignals signals;
         const Grid grid(job);
-        const Extent shape = grid.shape();
-        const std::uint64_t tile_points = job.tile_points.value_or(default_tile_points(job.points(), world.size()));
-        ResultFile file = d.mode == Mode::fresh
-                              ? ResultFile::create(out, world, job, grid, Tiling(shape, default_tile_shape(shape, tile_points)))
-                              : ResultFile::open(out, world);
+        ResultFile file = d.mode == Mode::fresh ? ResultFile::create(out, world, job, grid, default_tiling(job, world.size()))
+                                                : ResultFile::open(out, world);
         const Tiling& tiling = file.tiling();
 
         std::deque<std::uint64_t> pending;
@@ -189,18 +187,19 @@ int explore(const ExploreOptions& opt)
         std::vector<std::uint32_t> counts;
         std::vector<std::uint8_t> outcomes;
         std::vector<std::uint64_t> histogram(outcome_count, 0);
-        // Rank 0 answers requests this often (in points) while it computes.
-        constexpr std::size_t block = 512;
-        const auto kernel = opt.kernel == "scalar" ? &count_each : &count_each_simd;
+        std::uint64_t computed = 0;  // points counted by the kernel (fewer than the tiles' with refinement)
+        const CountKernel kernel = opt.kernel == "scalar" ? &count_each : &count_each_simd;
         const TileWork work = [&](std::uint64_t t, const Serve& serve) {
-            grid.starts(tiling.box(t), starts);
+            const Box box = tiling.box(t);
+            grid.starts(box, starts);
             counts.resize(starts.size());
             outcomes.resize(starts.size());
-            for (std::size_t i = 0; i < starts.size(); i += block) {
-                const std::size_t n = std::min(block, starts.size() - i);
-                kernel(starts.view().subview(i, n), matrices, job.max_bounces, std::span(counts).subspan(i, n),
-                           std::span(outcomes).subspan(i, n));
-                serve();
+            if (job.refine != 0) {
+                computed += refine_tile(box.count, starts.view(), job.refine, kernel, matrices, job.max_bounces, counts,
+                                        outcomes, serve);
+            } else {
+                count_in_blocks(kernel, starts.view(), matrices, job.max_bounces, counts, outcomes, serve);
+                computed += starts.size();
             }
             file.write_tile(t, counts, outcomes);
             for (const std::uint8_t o : outcomes) ++histogram[o];
@@ -214,11 +213,19 @@ int explore(const ExploreOptions& opt)
         // Attributes are written collectively and must be identical on every rank.
         const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         file.finish(world.broadcast(run_seconds), world.size(), !r.interrupted);
-        const std::vector<std::uint64_t> total = world.sum(histogram);
+        histogram.push_back(computed);  // summed with the histogram: one reduction
+        std::vector<std::uint64_t> total = world.sum(histogram);
+        const std::uint64_t computed_total = total.back();
+        total.pop_back();
         const double peak_mib = world.max(peak_rss_mib());
         if (root) {
             write_xdmf(out, read_result_info(out));
             print_summary(job, out, progress, total, !r.interrupted, peak_mib);
+            if (job.refine != 0) {
+                fmt::print(stderr, "refinement: {} of {} points counted ({:.1f}%), the others filled from agreeing corners\n",
+                           computed_total, progress.points_this_run(),
+                           100.0 * static_cast<double>(computed_total) / static_cast<double>(std::max<std::uint64_t>(progress.points_this_run(), 1)));
+            }
             if (r.interrupted) {
                 fmt::print(stderr, "stopped by a signal: {} is consistent and incomplete; run the same command with "
                                    "--resume to finish it\n",

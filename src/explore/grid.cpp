@@ -18,6 +18,14 @@ Grid::Grid(const Job& job) : coordinates_(job.coordinates), frame_(job.frame)
     }
 }
 
+Tiling default_tiling(const Job& job, int ranks)
+{
+    Extent shape;
+    for (const Coordinate* c : job.range_axes()) shape.push_back(c->range->n);
+    const std::uint64_t points = job.tile_points.value_or(default_tile_points(job.points(), job.refine ? 1 : ranks));
+    return Tiling(shape, default_tile_shape(shape, points));
+}
+
 Extent Grid::shape() const
 {
     Extent e;

@@ -34,4 +34,10 @@ private:
     std::vector<std::vector<double>> samples_;
 };
 
+// The tiling of a new result: [run] tile_points, or a default from the grid size and the
+// rank count. With refinement the results depend on the tile shape (cells do not cross
+// tiles), so there the default ignores the rank count: any number of ranks gives the
+// same file.
+Tiling default_tiling(const Job& job, int ranks);
+
 }  // namespace superball

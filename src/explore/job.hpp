@@ -53,6 +53,9 @@ struct Job {
     std::uint32_t max_bounces = 1000;
     std::string output;                   // [run] output, as written (may be empty: then the CLI must be given one)
     std::optional<std::uint64_t> tile_points;  // [run] tile_points: target points per tile
+    // [run] refine: 0 computes every point; a power of two s computes every s-th point
+    // and subdivides only the cells whose corners disagree (explore/refine.hpp).
+    std::uint32_t refine = 0;
     std::string text;                     // the job file's text, stored in results
 
     // The range axes, in order (1 to 3 of them).

@@ -35,7 +35,7 @@ constexpr std::int64_t max_max_bounces = std::numeric_limits<std::uint32_t>::max
 const std::vector<std::string> top_level_keys = {"model", "grid", "run"};
 const std::vector<std::string> model_keys = {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "g", "radius"};
 const std::vector<std::string> range_keys = {"min", "max", "n"};
-const std::vector<std::string> run_keys = {"max_bounces", "output", "tile_points"};
+const std::vector<std::string> run_keys = {"max_bounces", "output", "tile_points", "refine"};
 
 [[noreturn]] void fail(std::string message) { throw InputError(std::move(message)); }
 
@@ -438,6 +438,12 @@ void parse_run(const toml::table* run, Job& job)
         job.tile_points = static_cast<std::uint64_t>(
             integer_in(*n, "[run] tile_points", 1, max_tile_points, "1 <= tile_points <= " + std::to_string(max_tile_points)));
     }
+    if (const toml::node* n = run->get("refine")) {
+        constexpr const char* accepted = "0 (every point) or a power of two from 2 to 64 (the coarse stride)";
+        const auto r = integer_in(*n, "[run] refine", 0, 64, accepted);
+        if ((r & (r - 1)) != 0) fail("[run] refine = " + std::to_string(r) + " is out of range: accepted " + accepted);
+        job.refine = static_cast<std::uint32_t>(r);
+    }
 }
 
 Job validate(const toml::table& root)
@@ -522,6 +528,8 @@ std::string fingerprint(const Job& job)
         out += "radius = " + format_double(job.frame.radius) + "\n";
     }
     out += "max_bounces = " + std::to_string(job.max_bounces) + "\n";
+    // Refinement can change results: a refined file is another job than a full one.
+    if (job.refine != 0) out += "refine = " + std::to_string(job.refine) + "\n";
     return out;
 }
 

@@ -124,6 +124,8 @@ ResultFile ResultFile::create(const std::filesystem::path& path, const mpi::Comm
         h5::write_attribute(file, "radius", job.frame.radius);
     }
     h5::write_attribute(file, "max_bounces", static_cast<std::int64_t>(job.max_bounces));
+    // 0: every point computed; s: adaptive refinement from every s-th point.
+    h5::write_attribute(file, "refine", static_cast<std::int64_t>(job.refine));
     h5::write_attribute(file, "job_toml", job.text);
     h5::write_attribute(file, "job_fingerprint", fingerprint(job));
     h5::write_attribute(file, "software_version", std::string(software_version));

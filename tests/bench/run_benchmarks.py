@@ -24,9 +24,10 @@ def kernel_rates(bench, n):
     return rates
 
 
-def explore(superball, job, ranks, workdir):
-    """(points/s as explore reports it, wall seconds of the whole command, peak MiB per rank)."""
-    out = os.path.join(workdir, f"r{ranks}.h5")
+def explore(superball, job, ranks, workdir, keep=None):
+    """(points/s as explore reports it, wall seconds of the whole command, peak MiB per
+    rank); the result is deleted unless `keep` names it."""
+    out = os.path.join(workdir, keep or f"r{ranks}.h5")
     cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", superball, "explore", job, "-o", out, "--overwrite", "-q"]
     start = datetime.datetime.now()
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -35,8 +36,24 @@ def explore(superball, job, ranks, workdir):
         sys.exit(f"{' '.join(cmd)} failed:\n{r.stderr}")
     rate = float(re.search(r"\(([0-9.e+]+) points/s\)", r.stderr).group(1))
     peak = float(re.search(r"peak memory per rank: ([0-9.]+) MiB", r.stderr).group(1))
-    os.remove(out)
+    if not keep:
+        os.remove(out)
     return rate, wall, peak
+
+
+def refinement(superball, job_text, name, workdir):
+    """Full computation against refine = 8 on one grid, 2 ranks: (speed-up, mismatch)."""
+    import h5py  # Debian's python3-h5py
+    results = {}
+    for refine in (0, 8):
+        job = os.path.join(workdir, f"{name}-{refine}.toml")
+        with open(job, "w") as f:
+            f.write(job_text.replace("[run]", f"[run]\nrefine = {refine}"))
+        rate, _, _ = explore(superball, job, 2, workdir, keep=f"{name}-{refine}.h5")
+        with h5py.File(os.path.join(workdir, f"{name}-{refine}.h5"), "r") as f:
+            results[refine] = (rate, f["wall_bounces"][()], f["outcome"][()])
+    (rate0, w0, o0), (rate8, w8, o8) = results[0], results[8]
+    return rate8 / rate0, float(((w0 != w8) | (o0 != o8)).mean())
 
 
 def main():
@@ -65,6 +82,12 @@ def main():
             rows.append(("explore -n 2, 16384^2", rate, f"{wall:.2f} s wall, peak {peak:.0f} MiB/rank"))
             peaks[(16384, 2)] = peak
 
+        slice_text = open(os.path.join(HERE, "slice_4096.toml")).read()
+        volume_text = slice_text.replace("U = -1.0", "U = { min = -3.0, max = -0.05, n = 256 }").replace(
+            "n = 4096", "n = 256")
+        refined = [("4096^2 slice", *refinement(superball, slice_text, "slice", d)),
+                   ("256^3 volume, U in [-3, -0.05]", *refinement(superball, volume_text, "volume", d))]
+
     print("\n| run (4096^2 slice unless said) | points/s | vs scalar kernel | notes |")
     print("|---|---|---|---|")
     for name, rate, note in rows:
@@ -73,6 +96,10 @@ def main():
     print(f"\nvectorised / scalar kernel: {k['vectorised'][0] / scalar:.2f}x (target >= 2.5)")
     print(f"explore -n 2 / explore -n 1: {n2 / n1:.2f}x (target >= 1.8)")
     print(f"explore -n 1 / vectorised kernel: {n1 / k['vectorised'][0]:.2f} (target >= 0.85)")
+    print("\n| refine = 8 against the full grid (2 ranks) | speed-up | points that differ |")
+    print("|---|---|---|")
+    for name, speedup, mismatch in refined:
+        print(f"| {name} | {speedup:.2f}x | {100 * mismatch:.4f}% |")
     if (16384, 2) in peaks:
         ratio = peaks[(16384, 2)] / peaks[(4096, 2)]
         print(f"peak memory per rank 16384^2 / 4096^2 (2 ranks): {ratio:.3f} (target < 1.10)")

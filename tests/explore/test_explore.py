@@ -211,6 +211,34 @@ class Explore(unittest.TestCase):
             self.assertEqual(f["wall_bounces"].dtype, np.uint32)  # max_bounces > 65535
         self.assertFalse(os.path.exists(self.path("line.xmf")))
 
+    def test_refine(self):
+        """Adaptive refinement: the same file for any rank count, close to the full
+        computation, exact where the grid is uniform, and recorded in the file."""
+        grid = 'xi = { min = 0.0, max = 1.0, n = 150 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 130 }'
+        full_job = self.write_job(job_text(grid), "full.toml")
+        refined_job = self.write_job(job_text(grid, run="max_bounces = 1000\nrefine = 8"), "refined.toml")
+        full, one, three = self.path("full.h5"), self.path("one.h5"), self.path("three.h5")
+        self.explore(full_job, full, 1)
+        r = self.explore(refined_job, one, 1)
+        self.assertRegex(r.stderr, r"refinement: \d+ of 19500 points counted")
+        counted = int(r.stderr.split("refinement: ")[1].split()[0])
+        self.assertLess(counted, 19500 // 2)
+        self.explore(refined_job, three, 3)
+        self.assert_same_results(one, three)
+        wf, of = self.datasets(full)
+        wr, orr = self.datasets(one)
+        mismatch = ((wf != wr) | (of != orr)).mean()
+        self.assertLess(mismatch, 0.01)
+        # W > -0.8 is all one bounce, left: refinement must reproduce it exactly.
+        with h5py.File(full, "r") as f:
+            calm = f["axes/W"][()] > -0.8
+            self.assertEqual(f.attrs["refine"], 0)
+        np.testing.assert_array_equal(wr[:, calm], wf[:, calm])
+        with h5py.File(one, "r") as f:
+            self.assertEqual(f.attrs["refine"], 8)
+        r = self.explore(refined_job, full, 1, ["--resume"], expect=2)  # a full result is another job
+        self.assertIn("different job", r.stderr)
+
     def test_refuses_to_overwrite(self):
         job = self.write_job(job_text(CANONICAL_2D))
         out = self.path("r.h5")

@@ -77,9 +77,9 @@ start_munge() {
   chmod 755 /run/munge
   say "starting munged"
   if command -v runuser >/dev/null; then
-    runuser -u munge -- /usr/sbin/munged || fail "munged did not start (see /var/log/munge/munged.log)"
+    runuser -u munge -- /usr/sbin/munged 9>&- || fail "munged did not start (see /var/log/munge/munged.log)"
   else
-    su -s /bin/sh munge -c /usr/sbin/munged || fail "munged did not start (see /var/log/munge/munged.log)"
+    su -s /bin/sh munge -c /usr/sbin/munged 9>&- || fail "munged did not start (see /var/log/munge/munged.log)"
   fi
   echo started >"$dir/munged.started"
   for _ in $(seq 50); do munge_works && return 0; sleep 0.1; done
@@ -140,8 +140,8 @@ start() {
   stop_daemons
   write_conf
   say "starting slurmctld and slurmd ($conf)"
-  SLURM_CONF=$conf slurmctld -i -f "$conf" || fail "slurmctld did not start (see $dir/slurmctld.log)"
-  SLURM_CONF=$conf slurmd -f "$conf" || fail "slurmd did not start (see $dir/slurmd.log)"
+  SLURM_CONF=$conf slurmctld -i -f "$conf" 9>&- || fail "slurmctld did not start (see $dir/slurmctld.log)"
+  SLURM_CONF=$conf slurmd -f "$conf" 9>&- || fail "slurmd did not start (see $dir/slurmd.log)"
   local state=""
   for _ in $(seq 60); do
     state=$(node_state "$conf")

@@ -1,0 +1,261 @@
+#!/usr/bin/python3
+"""jobs/slurm/explore.sbatch on a real one-node Slurm cluster started on this machine
+(tests/jobs/slurm_cluster.sh): a small job completes; a job stopped by SIGTERM leaves an
+incomplete, resumable file that a resubmission finishes, identical to a direct run.
+
+Run by ctest (SUPERBALL = the built binary, SUPERBALL_SOURCE_DIR = the repository), or by hand:
+  SUPERBALL=build/release/src/superball /usr/bin/python3 tests/jobs/test_slurm.py -v
+Skipped only when Slurm cannot run here (not root, packages cannot be installed). The cluster
+is stopped at the end when this test started it; SUPERBALL_KEEP_SLURM=1 keeps it running.
+"""
+
+import os
+import re
+import subprocess
+import tempfile
+import time
+import unittest
+
+import h5py
+import numpy as np
+
+SOURCE = os.path.abspath(os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", ".."))
+CLUSTER = os.path.join(SOURCE, "tests", "jobs", "slurm_cluster.sh")
+SBATCH_SCRIPT = os.path.join(SOURCE, "jobs", "slurm", "explore.sbatch")
+TIMEOUT = 180  # seconds for any one job to start and end
+
+TINY_JOB = """\
+[model]
+e = 0.9
+alpha = 0.9
+
+[grid]
+coordinates = "canonical"
+xi = { min = 0.0, max = 1.0, n = 48 }
+U = -1.0
+W = { min = -3.0, max = 3.0, n = 40 }
+
+[run]
+max_bounces = 1000
+output = "out/tiny.h5"
+"""
+
+# Garwin's ball (e = alpha = 1) in a corner of launches that mostly never leave: nearly every
+# point costs max_bounces iterations: about 4 CPU-seconds, spread over 64 short tiles (a stop
+# request is honoured within a fraction of a second).
+SLOW_JOB = """\
+[model]
+e = 1.0
+alpha = 1.0
+
+[grid]
+coordinates = "canonical"
+xi = { min = 0.0, max = 0.1, n = 256 }
+U = -0.3
+W = { min = -3.0, max = -2.5, n = 64 }
+
+[run]
+max_bounces = 12000
+tile_points = 256
+output = "out/slow.h5"
+"""
+
+cluster_env = {}
+started_here = False
+
+
+def superball_binary():
+    path = os.environ.get("SUPERBALL")
+    if path:
+        return os.path.abspath(path)
+    for build in ("build/release", "build/native"):
+        candidate = os.path.join(SOURCE, build, "src", "superball")
+        if os.access(candidate, os.X_OK):
+            return candidate
+    raise unittest.SkipTest("no superball binary: set SUPERBALL")
+
+
+def setUpModule():
+    global started_here
+    r = subprocess.run([CLUSTER, "start"], capture_output=True, text=True, timeout=600)
+    if r.returncode == 3:
+        raise unittest.SkipTest("Slurm cannot run on this machine: " + r.stderr.strip().splitlines()[-1])
+    if r.returncode != 0:
+        raise RuntimeError(f"{CLUSTER} start failed (exit status {r.returncode}):\n{r.stderr}")
+    conf = re.search(r"^SLURM_CONF=(.*)$", r.stdout, re.M)
+    if not conf:
+        raise RuntimeError(f"{CLUSTER} start printed no SLURM_CONF:\n{r.stdout}{r.stderr}")
+    started_here = "reusing" not in r.stderr
+    cluster_env.update(os.environ)
+    cluster_env.update(SLURM_CONF=conf.group(1), SUPERBALL=superball_binary())
+    # The job must find its own way to mpirun's root permission (the script sets it when root).
+    for var in ("OMPI_ALLOW_RUN_AS_ROOT", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "OMPI_MCA_rmaps_base_oversubscribe"):
+        cluster_env.pop(var, None)
+
+
+def tearDownModule():
+    if started_here and os.environ.get("SUPERBALL_KEEP_SLURM") != "1":
+        subprocess.run([CLUSTER, "stop"], capture_output=True, timeout=120)
+
+
+def run(args, cwd, timeout=TIMEOUT, check=True):
+    r = subprocess.run(args, cwd=cwd, env=cluster_env, capture_output=True, text=True, timeout=timeout)
+    if check and r.returncode != 0:
+        raise AssertionError(f"{' '.join(args)}: exit status {r.returncode}\n{r.stdout}{r.stderr}")
+    return r
+
+
+def job_fields(job_id):
+    """JobState, ExitCode, ... of a job as scontrol shows it (there is no accounting: no sacct)."""
+    out = run(["scontrol", "show", "job", "-o", str(job_id)], cwd="/").stdout
+    return dict(re.findall(r"(\w+)=(\S*)", out))
+
+
+def wait_for_end(job_id):
+    deadline = time.monotonic() + TIMEOUT
+    while time.monotonic() < deadline:
+        state = job_fields(job_id).get("JobState", "")
+        if state not in ("PENDING", "CONFIGURING", "RUNNING", "COMPLETING", "REQUEUED", "SUSPENDED"):
+            return job_fields(job_id)
+        time.sleep(0.2)
+    raise AssertionError(f"job {job_id} did not end within {TIMEOUT} s")
+
+
+def tiles_done(path):
+    """Tiles marked done in a result file being written (0 while it does not exist yet), as
+    `superball info` reports them."""
+    if not os.path.exists(path):
+        return 0
+    r = subprocess.run([superball_binary(), "info", path], capture_output=True, text=True, timeout=60)
+    m = re.search(r"^complete: +\w+ \((\d+) of \d+ tiles done\)", r.stdout, re.M)
+    return int(m.group(1)) if m else 0
+
+
+def read_result(path):
+    with h5py.File(path, "r") as f:
+        return ({name: f[name][...] for name in ("wall_bounces", "outcome", "axes/xi", "axes/W", "progress/tile_done")},
+                dict(f.attrs))
+
+
+class SlurmExplore(unittest.TestCase):
+    def setUp(self):
+        self._tmp = tempfile.TemporaryDirectory(prefix="superball-slurm-")
+        self.tmp = self._tmp.name
+        os.chmod(self.tmp, 0o755)
+
+    def tearDown(self):
+        self._tmp.cleanup()
+
+    def write(self, name, text):
+        with open(os.path.join(self.tmp, name), "w") as f:
+            f.write(text)
+
+    def log(self, job_id):
+        try:
+            with open(os.path.join(self.tmp, f"slurm-{job_id}.out")) as f:
+                return f.read()
+        except FileNotFoundError:
+            return f"(no slurm-{job_id}.out)"
+
+    def submit(self, job, *sbatch_options):
+        """Submits explore.sbatch on JOB from the temporary directory; returns the job id."""
+        r = run(["sbatch", "--parsable", "-n", "2", *sbatch_options, SBATCH_SCRIPT, job], cwd=self.tmp)
+        return int(r.stdout.strip().split(";")[0])
+
+    def submit_and_wait(self, job):
+        r = run(["sbatch", "--parsable", "--wait", "-n", "2", SBATCH_SCRIPT, job], cwd=self.tmp, check=False)
+        job_id = int(r.stdout.strip().splitlines()[0].split(";")[0])
+        return r.returncode, job_id
+
+    def interrupt(self, job, scancel_options, tiles_before):
+        """Submits JOB, signals it once more tiles than TILES_BEFORE are on disk, waits for its end."""
+        out = os.path.join(self.tmp, "out", "slow.h5")
+        job_id = self.submit(job)
+        deadline = time.monotonic() + TIMEOUT
+        while tiles_done(out) <= tiles_before:
+            state = job_fields(job_id).get("JobState")
+            if state not in ("PENDING", "CONFIGURING", "RUNNING"):
+                self.fail(f"job {job_id} ended ({state}) before it could be stopped:\n{self.log(job_id)}")
+            self.assertLess(time.monotonic(), deadline, "no tile done in time")
+            time.sleep(0.1)
+        run(["scancel", *scancel_options, "--signal=TERM", str(job_id)], cwd=self.tmp)
+        return job_id, wait_for_end(job_id)
+
+    def test_small_job_completes(self):
+        self.write("tiny.toml", TINY_JOB)
+        status, job_id = self.submit_and_wait("tiny.toml")
+        log = self.log(job_id)
+        self.assertEqual(status, 0, log)
+        fields = job_fields(job_id)
+        self.assertEqual(fields["JobState"], "COMPLETED", log)
+        self.assertEqual(fields["ExitCode"], "0:0")
+        self.assertIn("explore.sbatch: done: out/tiny.h5", log)
+
+        # The job's relative output lands in the submit directory, laid out as SPEC.md section 5.
+        data, attrs = read_result(os.path.join(self.tmp, "out", "tiny.h5"))
+        self.assertEqual(int(attrs["complete"]), 1)
+        self.assertEqual(int(attrs["mpi_ranks"]), 2)
+        self.assertEqual(data["wall_bounces"].shape, (48, 40))
+        self.assertEqual(data["wall_bounces"].dtype, np.uint16)
+        self.assertEqual(data["outcome"].shape, (48, 40))
+        self.assertEqual(data["outcome"].dtype, np.uint8)
+        self.assertTrue(np.all(data["progress/tile_done"] == 1))
+        self.assertTrue(np.all(np.isin(data["outcome"], (1, 2))), "every start valid, none capped")
+        self.assertGreater(len(np.unique(data["wall_bounces"])), 3)
+
+    def test_stopped_job_resumes_on_resubmission(self):
+        self.write("slow.toml", SLOW_JOB)
+        out = os.path.join(self.tmp, "out", "slow.h5")
+
+        # Stopped the way the time limit does it (--signal=B:TERM: only the batch shell is
+        # signalled, and the script passes SIGTERM on to the ranks).
+        job_id, fields = self.interrupt("slow.toml", ["--batch"], 0)
+        log = self.log(job_id)
+        self.assertEqual((fields["JobState"], fields["ExitCode"]), ("FAILED", "1:0"), log)
+        self.assertIn("stopped by a signal", log)
+        self.assertIn("resubmit the same command to continue", log)
+        data, attrs = read_result(out)
+        self.assertEqual(int(attrs["complete"]), 0)
+        first_stop = int(np.count_nonzero(data["progress/tile_done"]))
+        self.assertTrue(0 < first_stop < data["progress/tile_done"].size, first_stop)
+        info = run([superball_binary(), "info", out], cwd=self.tmp).stdout
+        self.assertRegex(info, r"complete: +no \(\d+ of 64 tiles done\)")
+
+        # Resubmitted, and stopped again as scancel --full does (every process of the job).
+        job_id, fields = self.interrupt("slow.toml", ["--full"], first_stop)
+        log = self.log(job_id)
+        self.assertIn("adding --resume", log)
+        self.assertIn(fields["JobState"], ("FAILED", "CANCELLED"), log)
+        data, attrs = read_result(out)
+        self.assertEqual(int(attrs["complete"]), 0)
+        self.assertGreater(int(np.count_nonzero(data["progress/tile_done"])), first_stop)
+
+        # Resubmitted once more: it finishes.
+        status, job_id = self.submit_and_wait("slow.toml")
+        log = self.log(job_id)
+        self.assertEqual(status, 0, log)
+        self.assertEqual(job_fields(job_id)["JobState"], "COMPLETED")
+        self.assertIn("adding --resume", log)
+        data, attrs = read_result(out)
+        self.assertEqual(int(attrs["complete"]), 1)
+        self.assertEqual(int(attrs["mpi_ranks"]), 2)
+
+        # Same data as one uninterrupted run on one rank.
+        direct = os.path.join(self.tmp, "direct.h5")
+        env = dict(cluster_env)
+        if os.getuid() == 0:
+            env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        subprocess.run([os.environ.get("MPIEXEC") or "mpirun", "-n", "1", superball_binary(), "explore", "slow.toml",
+                        "-o", direct, "-q"], cwd=self.tmp, env=env, check=True, capture_output=True, timeout=TIMEOUT)
+        expected, _ = read_result(direct)
+        for name in ("wall_bounces", "outcome", "axes/xi", "axes/W"):
+            np.testing.assert_array_equal(data[name], expected[name], err_msg=name)
+
+        # A further resubmission has nothing to do and succeeds.
+        status, job_id = self.submit_and_wait("slow.toml")
+        self.assertEqual(status, 0, self.log(job_id))
+        self.assertIn("nothing to do", self.log(job_id))
+
+
+if __name__ == "__main__":
+    unittest.main()
