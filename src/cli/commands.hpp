@@ -14,5 +14,7 @@ Runner add_count_command(CLI::App& app);
 Runner add_trajectory_command(CLI::App& app);
 Runner add_explore_command(CLI::App& app);
 Runner add_info_command(CLI::App& app);
+Runner add_analyse_command(CLI::App& app);
+Runner add_fixed_points_command(CLI::App& app);
 
 }  // namespace superball::cli

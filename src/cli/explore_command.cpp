@@ -14,6 +14,7 @@
 #include "explore/mpi.hpp"
 #include "explore/progress.hpp"
 #include "explore/refine.hpp"
+#include "explore/tile_counter.hpp"
 #include "explore/schedule.hpp"
 #include "explore/signals.hpp"
 #include "io/result_file.hpp"
@@ -110,6 +111,9 @@ void print_summary(const Job& job, const fs::path& out, const Progress& progress
 void print_plan(const Job& job, const fs::path& out, int ranks)
 {
     fmt::print("job: valid\ncoordinates: {}\n", name(job.coordinates));
+    for (const Coordinate& p : job.parameters) {
+        fmt::print("swept {}: {} samples in [{}, {}]\n", p.name, p.range->n, p.range->min, p.range->max);
+    }
     for (const Coordinate& c : job.grid) {
         if (c.is_range()) {
             fmt::print("axis {}: {} samples in [{}, {}]\n", c.name, c.range->n, c.range->min, c.range->max);
@@ -125,7 +129,17 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
     fmt::print("tiles: {} of up to {} points for {} rank{}\n", tiling.tiles(), tiling.box(0).points(), ranks,
                ranks == 1 ? "" : "s");
     std::error_code ec;
-    fmt::print("output: {}\noutput exists: {}\n", out.string(), fs::exists(out, ec) ? "yes" : "no");
+    const bool exists = fs::exists(out, ec);
+    fmt::print("output: {}\noutput exists: {}\n", out.string(), exists ? "yes" : "no");
+    if (!exists) return;
+    // For batch scripts deciding between a new run and --resume.
+    try {
+        const ResultInfo info = read_result_info(out);
+        fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n", info.complete ? "yes" : "no",
+                   info.tiles_done, info.tiles, info.job_fingerprint == fingerprint(job) ? "yes" : "no");
+    } catch (const std::exception&) {
+        fmt::print("output complete: unreadable (not a superball result)\n");
+    }
 }
 
 int explore(const ExploreOptions& opt)
@@ -182,23 +196,26 @@ int explore(const ExploreOptions& opt)
         }
         Progress progress(stderr, opt.quiet, tiling.tiles(), tiling.points(), done_tiles, done_points);
 
-        const ModelMatrices matrices = ModelMatrices::of(job.model);
         Starts starts;
         std::vector<std::uint32_t> counts;
         std::vector<std::uint8_t> outcomes;
         std::vector<std::uint64_t> histogram(outcome_count, 0);
         std::uint64_t computed = 0;  // points counted by the kernel (fewer than the tiles' with refinement)
-        const CountKernel kernel = opt.kernel == "scalar" ? &count_each : &count_each_simd;
+        TileCounter counter(opt.kernel == "scalar" ? &count_each : &count_each_simd, job.max_bounces);
+        std::vector<ModelRun> runs;
         const TileWork work = [&](std::uint64_t t, const Serve& serve) {
             const Box box = tiling.box(t);
             grid.starts(box, starts);
+            grid.model_runs(box, runs);
             counts.resize(starts.size());
             outcomes.resize(starts.size());
             if (job.refine != 0) {
-                computed += refine_tile(box.count, starts.view(), job.refine, kernel, matrices, job.max_bounces, counts,
-                                        outcomes, serve);
+                const CountPoints some = [&](std::span<const std::uint64_t> points) {
+                    counter.some(points, starts, runs, counts, outcomes, serve);
+                };
+                computed += refine_tile(box.count, job.refine, some, counts, outcomes);
             } else {
-                count_in_blocks(kernel, starts.view(), matrices, job.max_bounces, counts, outcomes, serve);
+                counter.all(starts, runs, counts, outcomes, serve);
                 computed += starts.size();
             }
             file.write_tile(t, counts, outcomes);

@@ -23,7 +23,7 @@ int main(int argc, char** argv)
 
     std::map<const CLI::App*, cli::Runner> runners;
     for (auto add : {cli::add_explore_command, cli::add_count_command, cli::add_trajectory_command,
-                     cli::add_info_command}) {
+                     cli::add_info_command, cli::add_analyse_command, cli::add_fixed_points_command}) {
         auto run = add(app);
         runners.emplace(app.get_subcommands({}).back(), std::move(run));
     }
@@ -39,7 +39,8 @@ int main(int argc, char** argv)
     } catch (const CLI::ParseError& e) {
         // CLI11 says "a subcommand is required" for a misspelt command: name it instead.
         if (argc > 1 && argv[1][0] != '-' && app.get_subcommands().empty()) {
-            fmt::print(stderr, "superball: unknown command '{}' (commands: explore, count, trajectory, info; see --help)\n",
+            fmt::print(stderr,
+                       "superball: unknown command '{}' (commands: explore, count, trajectory, info, analyse, fixed-points; see --help)\n",
                        argv[1]);
         } else {
             fmt::print(stderr, "superball: {} (run with --help for usage)\n", e.what());

@@ -4,7 +4,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <unsupported/Eigen/AutoDiff>
 
 namespace superball {
@@ -32,10 +31,12 @@ bool close(const CanonicalState<double>& a, const CanonicalState<double>& b)
 // The residual of G^k(s) = s in the variables the solver works in, (log xi, U, W): xi is
 // compared relatively. In plain differences the plane xi = 0 would look like a set of
 // approximate fixed points, since G maps it into itself where the ball comes off the
-// wall downward (boundary_planes.md): xi' - xi -> 0 there without xi' = xi.
-Eigen::Vector3d log_residual(const CanonicalState<double>& s, const CanonicalState<double>& image)
+// wall downward (boundary_planes.md): xi' - xi -> 0 there without xi' = xi. On the corner
+// plane xi stays 0 and only (U, W) are unknowns.
+Eigen::Vector3d log_residual(const CanonicalState<double>& s, const CanonicalState<double>& image, Domain domain)
 {
-    return {std::log(image.xi / s.xi), image.U - s.U, image.W - s.W};
+    const double xi = domain == Domain::corner ? 0.0 : std::log(image.xi / s.xi);
+    return {xi, image.U - s.U, image.W - s.W};
 }
 
 // Relative size of a residual: the xi part is relative already; U and W are compared with
@@ -45,10 +46,10 @@ double relative_size(const Eigen::Vector3d& r, const CanonicalState<double>& s)
     return std::max(std::abs(r(0)), r.tail<2>().norm() / std::hypot(s.U, s.W));
 }
 
-double relative_residual(const CanonicalState<double>& s, const ModelMatrices& m, int k)
+double relative_residual(const CanonicalState<double>& s, const ModelMatrices& m, int k, Domain domain)
 {
-    const auto image = iterate(s, m, k);
-    return image ? relative_size(log_residual(s, *image), s) : HUGE_VAL;
+    const auto image = iterate(s, m, k, domain);
+    return image ? relative_size(log_residual(s, *image, domain), s) : HUGE_VAL;
 }
 
 // Decreasing modulus; ties (complex pairs) by real part then imaginary part, so the order
@@ -84,12 +85,12 @@ StepJacobian step_jacobian(const CanonicalState<double>& s, const ModelMatrices&
     return j;
 }
 
-IterateJacobian iterate_jacobian(const CanonicalState<double>& s, const ModelMatrices& m, int k)
+IterateJacobian iterate_jacobian(const CanonicalState<double>& s, const ModelMatrices& m, int k, Domain domain)
 {
     IterateJacobian r;
     r.state = s;
     for (int i = 0; i < k; ++i) {
-        if (!in_region(r.state)) return r;
+        if (!in_domain(r.state, domain)) return r;
         const StepJacobian j = step_jacobian(r.state, m);
         // d(Lambda lambda) = dLambda lambda + Lambda dlambda D(G^i): the product rule, with
         // the new factor's gradient carried back to s by the chain rule.
@@ -98,18 +99,19 @@ IterateJacobian iterate_jacobian(const CanonicalState<double>& s, const ModelMat
         r.dG = j.dG * r.dG;
         r.state = j.step.next;
     }
-    r.in_region = in_region(r.state);
+    r.in_region = in_domain(r.state, domain);
     return r;
 }
 
-std::optional<CanonicalState<double>> iterate(const CanonicalState<double>& s, const ModelMatrices& m, int k)
+std::optional<CanonicalState<double>> iterate(const CanonicalState<double>& s, const ModelMatrices& m, int k,
+                                              Domain domain)
 {
     CanonicalState<double> c = s;
     for (int i = 0; i < k; ++i) {
-        if (!in_region(c)) return std::nullopt;
+        if (!in_domain(c, domain)) return std::nullopt;
         c = canonical_map(c, m).next;
     }
-    if (!in_region(c)) return std::nullopt;
+    if (!in_domain(c, domain)) return std::nullopt;
     return c;
 }
 
@@ -139,26 +141,38 @@ Stability classify(std::span<const std::complex<double>> eigenvalues)
     return Stability::marginal;
 }
 
-std::optional<CanonicalState<double>> newton_cycle(const CanonicalState<double>& start, const ModelMatrices& m, int k)
+std::optional<CanonicalState<double>> newton_cycle(const CanonicalState<double>& start, const ModelMatrices& m, int k,
+                                                   Domain domain)
 {
-    if (k < 1 || !in_region(start)) return std::nullopt;
+    const bool corner = domain == Domain::corner;
+    if (k < 1 || !(corner ? start.U < 0.0 && std::isfinite(start.W) : in_region(start))) return std::nullopt;
     // Unknowns (log xi, U, W): xi stays positive whatever the step, and the equation
-    // log xi' = log xi cannot be met on the plane xi = 0 (see log_residual).
-    const auto state = [](const Eigen::Vector3d& z) { return CanonicalState<double>{std::exp(z(0)), z(1), z(2)}; };
-    Eigen::Vector3d z{std::log(start.xi), start.U, start.W};
+    // log xi' = log xi cannot be met on the plane xi = 0 (see log_residual). On the corner
+    // plane z(0) is unused: its residual and its row and column of the matrix are 0, so the
+    // minimum-norm step leaves it alone.
+    const auto state = [corner](const Eigen::Vector3d& z) {
+        return CanonicalState<double>{corner ? 0.0 : std::exp(z(0)), z(1), z(2)};
+    };
+    Eigen::Vector3d z{corner ? 0.0 : std::log(start.xi), start.U, start.W};
     for (int it = 0; it < newton_max_iterations; ++it) {
         const CanonicalState<double> s = state(z);
-        const IterateJacobian j = iterate_jacobian(s, m, k);
+        const IterateJacobian j = iterate_jacobian(s, m, k, domain);
         if (!j.in_region) return std::nullopt;
-        const Eigen::Vector3d f = log_residual(s, j.state);
+        const Eigen::Vector3d f = log_residual(s, j.state, domain);
         const double size = relative_size(f, s);
         if (!std::isfinite(size)) return std::nullopt;
         if (size <= newton_tolerance) return s;
         // D(G^k) in the variables (log xi, U, W): rows and columns of xi scaled.
         Eigen::Matrix3d a = j.dG;
-        a.row(0) /= j.state.xi;
-        a.col(0) *= s.xi;
+        if (corner) {
+            a.row(0).setZero();
+            a.col(0).setZero();
+        } else {
+            a.row(0) /= j.state.xi;
+            a.col(0) *= s.xi;
+        }
         a -= Eigen::Matrix3d::Identity();
+        if (corner) a(0, 0) = 0.0;
         // Minimum-norm solution of a d = -f: on a family of cycles `a` is singular at the
         // solution, and this step goes to the nearest member instead of along the family.
         const Eigen::Vector3d d = -a.jacobiSvd(Eigen::ComputeFullU | Eigen::ComputeFullV).solve(f);
@@ -170,8 +184,8 @@ std::optional<CanonicalState<double>> newton_cycle(const CanonicalState<double>&
         double t = 1.0;
         for (int h = 0; h < newton_max_halvings && !accepted; ++h, t *= 0.5) {
             const Eigen::Vector3d trial = z + t * d;
-            const auto image = iterate(state(trial), m, k);
-            if (image && log_residual(state(trial), *image).norm() <= (1.0 - 1e-4 * t) * f_norm) {
+            const auto image = iterate(state(trial), m, k, domain);
+            if (image && log_residual(state(trial), *image, domain).norm() <= (1.0 - 1e-4 * t) * f_norm) {
                 z = trial;
                 accepted = true;
             }
@@ -184,32 +198,33 @@ std::optional<CanonicalState<double>> newton_cycle(const CanonicalState<double>&
     return std::nullopt;
 }
 
-std::optional<Cycle> make_cycle(const CanonicalState<double>& point, const ModelMatrices& m, int k)
+std::optional<Cycle> make_cycle(const CanonicalState<double>& point, const ModelMatrices& m, int k, Domain domain)
 {
-    if (k < 1 || !in_region(point)) return std::nullopt;
+    if (k < 1 || !in_domain(point, domain)) return std::nullopt;
     // Minimal period: the smallest divisor d of k with G^d(point) = point.
     int period = k;
     for (int d = 1; d < k; ++d) {
-        if (k % d == 0 && relative_residual(point, m, d) <= residual_tolerance) {
+        if (k % d == 0 && relative_residual(point, m, d, domain) <= residual_tolerance) {
             period = d;
             break;
         }
     }
     std::vector<CanonicalState<double>> orbit{point};
     for (int i = 1; i < period; ++i) {
-        const auto next = iterate(orbit.back(), m, 1);
+        const auto next = iterate(orbit.back(), m, 1, domain);
         if (!next) return std::nullopt;
         orbit.push_back(*next);
     }
     const auto first = std::min_element(orbit.begin(), orbit.end(), lexicographically_less);
     std::rotate(orbit.begin(), first, orbit.end());
 
-    const IterateJacobian j = iterate_jacobian(orbit.front(), m, period);
+    const IterateJacobian j = iterate_jacobian(orbit.front(), m, period, domain);
     if (!j.in_region) return std::nullopt;
     Cycle c;
     c.period = period;
+    c.corner = domain == Domain::corner;
     c.points = std::move(orbit);
-    c.residual = relative_size(log_residual(c.points.front(), j.state), c.points.front());
+    c.residual = relative_size(log_residual(c.points.front(), j.state, domain), c.points.front());
     if (!(c.residual <= residual_tolerance)) return std::nullopt;
     c.lambda = j.lambda;
     const Eigen::EigenSolver<Eigen::Matrix3d> solver(j.dG, false);
@@ -224,7 +239,7 @@ std::optional<Cycle> make_cycle(const CanonicalState<double>& point, const Model
 
 bool same_cycle(const Cycle& a, const Cycle& b)
 {
-    if (a.period != b.period || a.points.empty() || b.points.empty()) return false;
+    if (a.period != b.period || a.corner != b.corner || a.points.empty() || b.points.empty()) return false;
     // Any point, not just the representatives: two points of a cycle with nearly equal xi
     // may swap roles between two runs.
     return std::any_of(a.points.begin(), a.points.end(), [&](const auto& p) { return close(p, b.points.front()); });
@@ -237,36 +252,41 @@ std::vector<Cycle> distinct_cycles(std::span<const Cycle> cycles)
         if (std::none_of(kept.begin(), kept.end(), [&](const Cycle& k) { return same_cycle(k, c); })) kept.push_back(c);
     }
     std::stable_sort(kept.begin(), kept.end(), [](const Cycle& a, const Cycle& b) {
+        if (a.corner != b.corner) return b.corner;
         if (a.period != b.period) return a.period < b.period;
         return lexicographically_less(a.points.front(), b.points.front());
     });
     return kept;
 }
 
+CanonicalState<double> SeededStarts::next()
+{
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    // Three draws per start whatever happens, so start i depends on i only.
+    const double xi = unit(rng_);
+    const double U = -std::pow(10.0, -2.0 + 4.0 * unit(rng_));
+    const double W = 3.0 * std::max(1.0, -U) * (2.0 * unit(rng_) - 1.0);
+    // unit() may return exactly 0; such a start is moved off the plane xi = 0.
+    return {xi > 0.0 ? xi : 0.5, U, W};
+}
+
 std::vector<CanonicalState<double>> seeded_starts(std::uint64_t seed, std::uint64_t count)
 {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    SeededStarts draw(seed);
     std::vector<CanonicalState<double>> starts;
     starts.reserve(count);
-    while (starts.size() < count) {
-        // Three draws per start whatever happens, so start i depends on i only.
-        const double xi = unit(rng);
-        const double U = -std::pow(10.0, -2.0 + 4.0 * unit(rng));
-        const double W = 3.0 * std::max(1.0, -U) * (2.0 * unit(rng) - 1.0);
-        // unit() may return exactly 0; such a start is moved off the plane xi = 0.
-        starts.push_back({xi > 0.0 ? xi : 0.5, U, W});
-    }
+    while (starts.size() < count) starts.push_back(draw.next());
     return starts;
 }
 
-std::vector<Cycle> find_cycles(const ModelMatrices& m, int max_period, std::uint64_t starts, std::uint64_t seed)
+std::vector<Cycle> find_cycles(const ModelMatrices& m, int max_period, std::uint64_t starts, std::uint64_t seed,
+                               Domain domain)
 {
     std::vector<Cycle> found;
     for (const CanonicalState<double>& start : seeded_starts(seed, starts)) {
         for (int k = 1; k <= max_period; ++k) {
-            if (const auto p = newton_cycle(start, m, k)) {
-                if (auto c = make_cycle(*p, m, k)) found.push_back(std::move(*c));
+            if (const auto p = newton_cycle(start, m, k, domain)) {
+                if (auto c = make_cycle(*p, m, k, domain)) found.push_back(std::move(*c));
             }
         }
     }

@@ -25,6 +25,8 @@ struct ImpactMatrix {
     double c_Ws;    // (5/7)(1 + alpha): tangential velocity fed into the spin
     double c_WW;    // (2 - 5 alpha)/7: spin kept
 
+    friend constexpr bool operator==(const ImpactMatrix&, const ImpactMatrix&) = default;
+
     static constexpr ImpactMatrix of(Surface s)
     {
         return {s.e, (5.0 - 2.0 * s.alpha) / 7.0, 2.0 * (1.0 + s.alpha) / 7.0,
@@ -35,6 +37,8 @@ struct ImpactMatrix {
 struct ModelMatrices {
     ImpactMatrix wall;
     ImpactMatrix floor;
+
+    friend constexpr bool operator==(const ModelMatrices&, const ModelMatrices&) = default;
 
     static constexpr ModelMatrices of(const Model& m) { return {ImpactMatrix::of(m.wall), ImpactMatrix::of(m.floor)}; }
 };

@@ -5,16 +5,44 @@
 
 namespace superball {
 
-Grid::Grid(const Job& job) : coordinates_(job.coordinates), frame_(job.frame)
+namespace {
+
+std::vector<double> samples_of(const Range& r)
 {
-    for (std::size_t i = 0; i < job.grid.size(); ++i) {
-        const Coordinate& c = job.grid[i];
+    std::vector<double> s(r.n);
+    for (std::uint64_t k = 0; k < r.n; ++k) s[k] = r.sample(k);
+    return s;
+}
+
+// Calls f(index) for the multi-index of the first point of every row of `box` along its
+// last axis, in row-major order.
+template <class F>
+void for_each_row(const Box& box, F&& f)
+{
+    const std::size_t d = box.count.size();
+    Extent index(d, 0);
+    for (;;) {
+        f(index);
+        std::size_t k = d - 1;
+        while (k-- > 0) {
+            if (++index[k] < box.count[k]) break;
+            index[k] = 0;
+        }
+        if (k == static_cast<std::size_t>(-1)) return;
+    }
+}
+
+}  // namespace
+
+Grid::Grid(Job job) : job_(std::move(job))
+{
+    for (std::size_t p = 0; p < job_.parameters.size(); ++p) {
+        axes_.push_back({-1, static_cast<int>(p), samples_of(*job_.parameters[p].range)});
+    }
+    for (std::size_t i = 0; i < job_.grid.size(); ++i) {
+        const Coordinate& c = job_.grid[i];
         fixed_.push_back(c.fixed.value_or(0.0));
-        if (!c.is_range()) continue;
-        range_index_.push_back(i);
-        std::vector<double> s(c.range->n);
-        for (std::uint64_t k = 0; k < c.range->n; ++k) s[k] = c.range->sample(k);
-        samples_.push_back(std::move(s));
+        if (c.is_range()) axes_.push_back({static_cast<int>(i), -1, samples_of(*c.range)});
     }
 }
 
@@ -29,61 +57,85 @@ Tiling default_tiling(const Job& job, int ranks)
 Extent Grid::shape() const
 {
     Extent e;
-    for (const auto& s : samples_) e.push_back(s.size());
+    for (const Axis& a : axes_) e.push_back(a.samples.size());
     return e;
 }
 
 CanonicalState<double> Grid::canonical(const std::vector<double>& c) const
 {
-    if (coordinates_ == Coordinates::canonical) return {c[0], c[1], c[2]};
-    const PhysicalState<double> s{c[0], c[1], c[2], c[3] * frame_.radius};
+    if (job_.coordinates == Coordinates::canonical) return {c[0], c[1], c[2]};
+    const PhysicalState<double> s{c[0], c[1], c[2], c[3] * job_.frame.radius};
     if (!is_launch(s)) {
         constexpr double nan = std::numeric_limits<double>::quiet_NaN();
         return {nan, nan, nan};
     }
-    return to_canonical(s, frame_.g);
+    return to_canonical(s, job_.frame.g);
 }
 
 void Grid::starts(const Box& box, Starts& out) const
 {
     out.resize(box.points());
     std::vector<double> coords = fixed_;
-    const std::size_t d = samples_.size();
-    const std::size_t last = d - 1;
-    const double* fastest = samples_[last].data() + box.start[last];
-    double& varying = coords[range_index_[last]];
+    const std::size_t last = axes_.size() - 1;
+    const Axis& inner = axes_[last];
+    const std::uint64_t row = box.count[last];
     std::size_t p = 0;
-    // Odometer over every axis but the last; the last axis is the inner loop.
-    Extent index(d, 0);
-    for (;;) {
-        for (std::size_t k = 0; k < last; ++k) coords[range_index_[k]] = samples_[k][box.start[k] + index[k]];
-        const std::uint64_t row = box.count[last];
-        if (coordinates_ == Coordinates::canonical) {
-            // A row of canonical starts is two constant arrays and one copied axis: no
+    for_each_row(box, [&](const Extent& index) {
+        for (std::size_t k = 0; k < last; ++k) {
+            if (axes_[k].coordinate >= 0) coords[static_cast<std::size_t>(axes_[k].coordinate)] = axes_[k].samples[box.start[k] + index[k]];
+        }
+        const double* fastest = inner.samples.data() + box.start[last];
+        if (job_.coordinates == Coordinates::canonical) {
+            // A row of canonical starts is constant arrays and at most one copied axis: no
             // per-point work (this loop was 10% of a run when done point by point).
             std::vector<double>* arrays[] = {&out.xi, &out.U, &out.W};
-            for (std::size_t c = 0; c < 3; ++c) {
+            for (int c = 0; c < 3; ++c) {
                 double* dst = arrays[c]->data() + p;
-                if (c == range_index_[last]) {
+                if (c == inner.coordinate) {
                     std::copy(fastest, fastest + row, dst);
                 } else {
-                    std::fill(dst, dst + row, coords[c]);
+                    std::fill(dst, dst + row, coords[static_cast<std::size_t>(c)]);
                 }
             }
-            p += row;
         } else {
             for (std::uint64_t j = 0; j < row; ++j) {
-                varying = fastest[j];
-                out.set(p++, canonical(coords));
+                if (inner.coordinate >= 0) coords[static_cast<std::size_t>(inner.coordinate)] = fastest[j];
+                out.set(p + j, canonical(coords));
             }
         }
-        std::size_t k = last;
-        while (k-- > 0) {
-            if (++index[k] < box.count[k]) break;
-            index[k] = 0;
-        }
-        if (k == static_cast<std::size_t>(-1)) return;
+        p += row;
+    });
+}
+
+void Grid::model_runs(const Box& box, std::vector<ModelRun>& out) const
+{
+    out.clear();
+    if (job_.parameters.empty()) {
+        out.push_back({0, box.points(), ModelMatrices::of(job_.model)});
+        return;
     }
+    std::vector<double> values(job_.parameters.size());
+    const std::size_t last = axes_.size() - 1;
+    const std::uint64_t row = box.count[last];
+    std::size_t p = 0;
+    // Parameter axes come first, so the model is constant along a row unless the last
+    // axis itself is a parameter; consecutive rows of one model make one run.
+    for_each_row(box, [&](const Extent& index) {
+        for (std::size_t k = 0; k < last; ++k) {
+            if (axes_[k].parameter >= 0) values[static_cast<std::size_t>(axes_[k].parameter)] = axes_[k].samples[box.start[k] + index[k]];
+        }
+        for (std::uint64_t j = 0; j < (axes_[last].parameter >= 0 ? row : 1); ++j) {
+            if (axes_[last].parameter >= 0) values[static_cast<std::size_t>(axes_[last].parameter)] = axes_[last].samples[box.start[last] + j];
+            const std::size_t n = axes_[last].parameter >= 0 ? 1 : row;
+            const ModelMatrices m = ModelMatrices::of(job_.model_at(values));
+            if (!out.empty() && out.back().first + out.back().count == p && out.back().matrices == m) {
+                out.back().count += n;
+            } else {
+                out.push_back({p, n, m});
+            }
+            p += n;
+        }
+    });
 }
 
 }  // namespace superball

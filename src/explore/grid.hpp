@@ -1,4 +1,5 @@
-// The points of a job's grid, tile by tile, as canonical launch states.
+// The points of a job's grid, tile by tile: canonical launch states, and the model of
+// each point (which varies along swept coefficients).
 #pragma once
 
 #include <span>
@@ -10,28 +11,42 @@
 
 namespace superball {
 
+// Consecutive points of a box (row-major) that share one model.
+struct ModelRun {
+    std::size_t first = 0;
+    std::size_t count = 0;
+    ModelMatrices matrices{};
+};
+
 class Grid {
 public:
-    explicit Grid(const Job& job);
+    explicit Grid(Job job);
 
     Extent shape() const;
-    std::size_t dimensions() const { return samples_.size(); }
+    std::size_t dimensions() const { return axes_.size(); }
     // Sample values of range axis k (cell centres, Range::sample).
-    const std::vector<double>& samples(std::size_t k) const { return samples_[k]; }
+    const std::vector<double>& samples(std::size_t k) const { return axes_[k].samples; }
 
     // The canonical start of every point of `box`, row-major (last axis fastest).
     // Physical points that are not a launch toward the wall become a non-admissible
     // canonical state (NaN), which count() reports as invalid.
     void starts(const Box& box, Starts& out) const;
 
+    // The points of `box` grouped by model: one run when no coefficient is swept.
+    void model_runs(const Box& box, std::vector<ModelRun>& out) const;
+
 private:
+    struct Axis {
+        int coordinate = -1;  // index in the job's coordinates, or -1
+        int parameter = -1;   // index in the job's swept parameters, or -1
+        std::vector<double> samples;
+    };
+
     CanonicalState<double> canonical(const std::vector<double>& coords) const;
 
-    Coordinates coordinates_;
-    Frame frame_;
-    std::vector<double> fixed_;              // every coordinate; ranges overwritten per point
-    std::vector<std::size_t> range_index_;   // which coordinate each range axis is
-    std::vector<std::vector<double>> samples_;
+    Job job_;
+    std::vector<double> fixed_;  // every coordinate; ranges overwritten per point
+    std::vector<Axis> axes_;     // the range axes, in result order
 };
 
 // The tiling of a new result: [run] tile_points, or a default from the grid size and the

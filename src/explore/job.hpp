@@ -2,7 +2,9 @@
 // result goes.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <span>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -45,11 +47,20 @@ struct Coordinate {
     friend bool operator==(const Coordinate&, const Coordinate&) = default;
 };
 
+// The model coefficients a job may sweep as range axes, in the order their axes come in
+// results (before the coordinates).
+std::vector<std::string> coefficient_names();  // {"e","alpha","e_wall","alpha_wall","e_floor","alpha_floor"}
+
 struct Job {
-    Model model{};
+    Model model{};  // swept coefficients hold their range's min here (see model_at)
     Coordinates coordinates = Coordinates::canonical;
     Frame frame{};                        // g and radius: physical grids only
     std::vector<Coordinate> grid;         // every coordinate, in coordinate_names() order
+    // Model coefficients given as ranges in [model], in coefficient_names() order.
+    std::vector<Coordinate> parameters;
+    // For e_wall, alpha_wall, e_floor, alpha_floor: the index in `parameters` of the axis
+    // that sets it, or -1 when it is fixed (per-surface keys override e and alpha).
+    std::array<int, 4> swept{-1, -1, -1, -1};
     std::uint32_t max_bounces = 1000;
     std::string output;                   // [run] output, as written (may be empty: then the CLI must be given one)
     std::optional<std::uint64_t> tile_points;  // [run] tile_points: target points per tile
@@ -58,8 +69,10 @@ struct Job {
     std::uint32_t refine = 0;
     std::string text;                     // the job file's text, stored in results
 
-    // The range axes, in order (1 to 3 of them).
+    // The range axes, in result order: swept parameters, then coordinates (1 to 4 in all).
     std::vector<const Coordinate*> range_axes() const;
+    // The model at given values of the swept parameters (one per entry of `parameters`).
+    Model model_at(std::span<const double> parameter_values) const;
     // Number of grid points (product of the range sizes).
     std::uint64_t points() const;
 };

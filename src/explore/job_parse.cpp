@@ -287,9 +287,11 @@ Coordinates parse_coordinates_kind(const toml::table* grid)
     fail(spelled + " is not accepted: accepted " + accepted);
 }
 
-Range parse_range(const toml::table& table, std::string_view name)
+// `table_name`: "[grid]" or "[model]", for messages.
+Range parse_range(const toml::table& table, std::string_view name, std::string_view table_name = "[grid]")
 {
-    const std::string prefix = "[grid] " + std::string(name) + ".";
+    const std::string where = std::string(table_name) + " " + std::string(name);
+    const std::string prefix = where + ".";
     reject_unknown_keys(table, prefix, range_keys);
     const auto required = [&](std::string_view key) -> const toml::node& {
         const toml::node* node = table.get(key);
@@ -300,15 +302,20 @@ Range parse_range(const toml::table& table, std::string_view name)
     const double max = finite_number(required("max"), prefix + "max");
     const std::int64_t n = integer_in(required("n"), prefix + "n", 1, std::numeric_limits<std::int64_t>::max(), "n >= 1");
     if (!(min < max)) {
-        fail("[grid] " + std::string(name) + " has min = " + format_double(min) + " and max = " + format_double(max) +
-             ": accepted min < max");
+        fail(where + " has min = " + format_double(min) + " and max = " + format_double(max) + ": accepted min < max");
     }
     // Samples are computed from max - min, which must not overflow.
     if (!std::isfinite(max - min)) {
-        fail("[grid] " + std::string(name) + " has min = " + format_double(min) + " and max = " + format_double(max) +
+        fail(where + " has min = " + format_double(min) + " and max = " + format_double(max) +
              ": max - min overflows, accepted a finite width");
     }
-    return {min, max, static_cast<std::uint64_t>(n)};
+    // So must (i + 0.5)(max - min), the product in Range::sample (largest at the last sample).
+    const Range range{min, max, static_cast<std::uint64_t>(n)};
+    if (!std::isfinite(range.sample(range.n - 1))) {
+        fail(where + " has min = " + format_double(min) + " and max = " + format_double(max) + " with n = " +
+             std::to_string(n) + ": the samples overflow, accepted (n - 0.5)(max - min) finite");
+    }
+    return range;
 }
 
 Coordinate parse_coordinate(const toml::table* grid, const std::string& name)
@@ -353,7 +360,8 @@ void check_points(const std::vector<Coordinate>& grid)
     }
 }
 
-std::vector<Coordinate> parse_grid(const toml::table* grid, Coordinates kind)
+// `parameters`: the swept model coefficients, which count toward the range axes.
+std::vector<Coordinate> parse_grid(const toml::table* grid, Coordinates kind, const std::vector<Coordinate>& parameters)
 {
     if (grid) reject_unknown_grid_keys(*grid, kind);
     std::vector<Coordinate> coordinates;
@@ -363,14 +371,24 @@ std::vector<Coordinate> parse_grid(const toml::table* grid, Coordinates kind)
     for (const Coordinate& c : coordinates) {
         if (c.is_range()) ranges.push_back(c.name);
     }
-    if (ranges.empty()) {
-        fail("[grid] has no range: accepted 1 to 3 of " + join(coordinate_names(kind)) + " as { min, max, n }");
+    if (ranges.empty() && parameters.empty()) {
+        fail("[grid] has no range: accepted 1 to 3 of " + join(coordinate_names(kind)) +
+             " as { min, max, n } (or a model coefficient swept as a range)");
     }
     if (ranges.size() > 3) {
         fail("[grid] has " + std::to_string(ranges.size()) + " ranges (" + join(ranges) +
              "): accepted 1 to 3, give one of them a fixed value");
     }
-    check_points(coordinates);
+    std::vector<std::string> all;
+    for (const Coordinate& p : parameters) all.push_back("[model] " + p.name);
+    for (const std::string& r : ranges) all.push_back(r);
+    if (all.size() > 4) {
+        fail("the job has " + std::to_string(all.size()) + " range axes (" + join(all) +
+             "): accepted at most 4 in all, give some a fixed value");
+    }
+    std::vector<Coordinate> axes = parameters;
+    axes.insert(axes.end(), coordinates.begin(), coordinates.end());
+    check_points(axes);
     return coordinates;
 }
 
@@ -395,9 +413,16 @@ double positive_finite(const toml::table* model, std::string_view key, double fa
     return x;
 }
 
-Model parse_model(const toml::table* model, Coordinates kind)
+// A coefficient given as { min, max, n } is swept (issue 6): it becomes a range axis.
+// The model is resolved twice, with every swept coefficient at its min and at its max:
+// the accepted values form intervals, so the ends decide for every sample between them.
+void parse_model(const toml::table* model, Coordinates kind, Job& job)
 {
-    if (!model) return resolve_model({}, [](std::string_view key) { return "[model] " + std::string(key); });
+    const auto spell = [](std::string_view key) { return "[model] " + std::string(key); };
+    if (!model) {
+        job.model = resolve_model({}, spell);
+        return;
+    }
     reject_unknown_keys(*model, "[model] ", model_keys);
     if (kind == Coordinates::canonical) {
         for (const char* key : {"g", "radius"}) {
@@ -406,10 +431,40 @@ Model parse_model(const toml::table* model, Coordinates kind)
             }
         }
     }
-    const ModelInput in{optional_number(model, "e"),       optional_number(model, "alpha"),
-                        optional_number(model, "e_wall"),  optional_number(model, "alpha_wall"),
-                        optional_number(model, "e_floor"), optional_number(model, "alpha_floor")};
-    return resolve_model(in, [](std::string_view key) { return "[model] " + std::string(key); });
+    const std::vector<std::string> names = coefficient_names();
+    std::vector<int> axis(names.size(), -1);  // per coefficient key: its parameter axis, or -1
+    for (std::size_t k = 0; k < names.size(); ++k) {
+        const toml::node* node = model->get(names[k]);
+        if (const auto* table = node ? node->as_table() : nullptr) {
+            axis[k] = static_cast<int>(job.parameters.size());
+            job.parameters.push_back({names[k], std::nullopt, parse_range(*table, names[k], "[model]")});
+        }
+    }
+    const auto value = [&](std::size_t k, bool at_max) -> std::optional<double> {
+        if (axis[k] < 0) return optional_number(model, names[k]);
+        const Range& r = *job.parameters[static_cast<std::size_t>(axis[k])].range;
+        return at_max ? r.max : r.min;
+    };
+    for (const bool at_max : {false, true}) {
+        const ModelInput in{value(0, at_max), value(1, at_max), value(2, at_max),
+                            value(3, at_max), value(4, at_max), value(5, at_max)};
+        const Model m = resolve_model(in, [&](std::string_view key) {
+            const auto k = static_cast<std::size_t>(std::find(names.begin(), names.end(), key) - names.begin());
+            return spell(key) + (k < names.size() && axis[k] >= 0 ? (at_max ? ".max" : ".min") : "");
+        });
+        if (!at_max) job.model = m;
+    }
+    // Which axis sets each coefficient: a per-surface key wins over the shared one.
+    const std::size_t shared[4] = {0, 1, 0, 1}, specific[4] = {2, 3, 4, 5};
+    for (std::size_t c = 0; c < 4; ++c) {
+        job.swept[c] = model->contains(names[specific[c]]) ? axis[specific[c]] : axis[shared[c]];
+    }
+    for (const std::size_t k : {0u, 1u}) {
+        if (axis[k] >= 0 && model->contains(names[k + 2]) && model->contains(names[k + 4])) {
+            fail("[model] " + names[k] + " is a range, but " + names[k + 2] + " and " + names[k + 4] +
+                 " are set too: nothing would follow it");
+        }
+    }
 }
 
 Frame parse_frame(const toml::table* model)
@@ -455,9 +510,9 @@ Job validate(const toml::table& root)
 
     Job job;
     job.coordinates = parse_coordinates_kind(grid);
-    job.model = parse_model(model, job.coordinates);
+    parse_model(model, job.coordinates, job);
     if (job.coordinates == Coordinates::physical) job.frame = parse_frame(model);
-    job.grid = parse_grid(grid, job.coordinates);
+    job.grid = parse_grid(grid, job.coordinates, job.parameters);
     parse_run(run, job);
     return job;
 }
@@ -518,6 +573,10 @@ std::string fingerprint(const Job& job)
         } else {
             out += format_double(c.fixed.value_or(std::nan(""))) + "\n";
         }
+    }
+    for (const Coordinate& p : job.parameters) {
+        out += "swept " + p.name + " = { min = " + format_double(p.range->min) + ", max = " + format_double(p.range->max) +
+               ", n = " + std::to_string(p.range->n) + " }\n";
     }
     out += "e_wall = " + format_double(job.model.wall.e) + "\n";
     out += "alpha_wall = " + format_double(job.model.wall.alpha) + "\n";

@@ -113,45 +113,20 @@ enum : std::uint8_t { unknown = 0, computed = 1, filled = 2, wanted = 3 };
 
 }  // namespace
 
-void count_in_blocks(CountKernel kernel, const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
-                     std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes,
-                     const std::function<void()>& serve)
-{
-    // Small enough that rank 0 answers requests within milliseconds even where every
-    // point bounces to max_bounces, large enough to fill the vector kernel.
-    constexpr std::size_t block = 512;
-    for (std::size_t i = 0; i < starts.size(); i += block) {
-        const std::size_t n = std::min(block, starts.size() - i);
-        kernel(starts.subview(i, n), m, max_bounces, wall_bounces.subspan(i, n), outcomes.subspan(i, n));
-        serve();
-    }
-}
-
-std::uint64_t refine_tile(const Extent& shape, const StartsView& starts, std::uint32_t stride, CountKernel kernel,
-                          const ModelMatrices& m, std::uint32_t max_bounces, std::span<std::uint32_t> wall_bounces,
-                          std::span<std::uint8_t> outcomes, const std::function<void()>& serve)
+std::uint64_t refine_tile(const Extent& shape, std::uint32_t stride, const CountPoints& count,
+                          std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
 {
     const Layout layout(shape);
     const std::size_t d = layout.dims();
-    std::vector<std::uint8_t> state(starts.size(), unknown);
+    std::vector<std::uint8_t> state(wall_bounces.size(), unknown);
     std::vector<std::uint64_t> need;
-    Starts subset;
-    std::vector<std::uint32_t> sub_counts;
-    std::vector<std::uint8_t> sub_outcomes;
     std::uint64_t total = 0;
 
-    // Computes the points listed in `need` (gathered, counted, scattered back).
+    // Computes the points listed in `need`.
     auto compute = [&] {
-        subset.clear();
-        for (const std::uint64_t i : need) subset.push_back(starts[i]);
-        sub_counts.resize(need.size());
-        sub_outcomes.resize(need.size());
-        count_in_blocks(kernel, subset.view(), m, max_bounces, sub_counts, sub_outcomes, serve);
-        for (std::size_t j = 0; j < need.size(); ++j) {
-            wall_bounces[need[j]] = sub_counts[j];
-            outcomes[need[j]] = sub_outcomes[j];
-            state[need[j]] = computed;
-        }
+        std::sort(need.begin(), need.end());
+        count(need);
+        for (const std::uint64_t i : need) state[i] = computed;
         total += need.size();
         need.clear();
     };

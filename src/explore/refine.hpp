@@ -10,26 +10,17 @@
 #include <functional>
 #include <span>
 
-#include "core/count.hpp"
 #include "tiles.hpp"
 
 namespace superball {
 
-// count_each() or count_each_simd().
-using CountKernel = void (*)(const StartsView&, const ModelMatrices&, std::uint32_t, std::span<std::uint32_t>,
-                             std::span<std::uint8_t>);
+// Counts the listed points of the tile (ascending indices) into the result arrays.
+using CountPoints = std::function<void(std::span<const std::uint64_t> points)>;
 
-// Runs `kernel` over `starts` in blocks, calling `serve` between blocks (rank 0 answers
-// the other ranks' requests there).
-void count_in_blocks(CountKernel kernel, const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
-                     std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes,
-                     const std::function<void()>& serve);
-
-// Fills wall_bounces/outcomes for every point of a tile of `shape` (row-major, `starts`
-// holds all its points) computing only what the refinement needs; returns the number of
+// Fills wall_bounces/outcomes for every point of a tile of `shape` (row-major),
+// computing through `count` only what the refinement needs; returns the number of
 // points computed. stride: a power of two >= 2.
-std::uint64_t refine_tile(const Extent& shape, const StartsView& starts, std::uint32_t stride, CountKernel kernel,
-                          const ModelMatrices& m, std::uint32_t max_bounces, std::span<std::uint32_t> wall_bounces,
-                          std::span<std::uint8_t> outcomes, const std::function<void()>& serve);
+std::uint64_t refine_tile(const Extent& shape, std::uint32_t stride, const CountPoints& count,
+                          std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes);
 
 }  // namespace superball

@@ -97,28 +97,43 @@ ResultFile ResultFile::create(const std::filesystem::path& path, const mpi::Comm
     }
 
     const h5::Id axes = h5::group_id(H5Gcreate2(file, "/axes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "/axes");
-    std::vector<std::string> axis_names;
-    std::size_t k = 0;
     for (const Coordinate& c : job.grid) {
-        if (!c.is_range()) {
-            h5::write_attribute(file, "fixed_" + c.name, *c.fixed);
-            continue;
-        }
-        axis_names.push_back(c.name);
-        const std::vector<double>& s = grid.samples(k++);
-        const h5::Id d = create_1d(axes, c.name.c_str(), H5T_IEEE_F64LE, s.size());
+        if (!c.is_range()) h5::write_attribute(file, "fixed_" + c.name, *c.fixed);
+    }
+    std::vector<std::string> axis_names;
+    const std::vector<const Coordinate*> ranges = job.range_axes();
+    for (std::size_t k = 0; k < ranges.size(); ++k) {
+        const std::string& name = ranges[k]->name;
+        axis_names.push_back(name);
+        const std::vector<double>& s = grid.samples(k);
+        const h5::Id d = create_1d(axes, name.c_str(), H5T_IEEE_F64LE, s.size());
         // Raw data: one rank writes it, the others take part in nothing.
         if (comm.is_root()) {
-            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data()), "write axis " + c.name);
+            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data()), "write axis " + name);
         }
     }
 
     h5::write_attribute(file, "coordinates", std::string(name(job.coordinates)));
     h5::write_attribute(file, "axis_names", axis_names);
-    h5::write_attribute(file, "e_wall", job.model.wall.e);
-    h5::write_attribute(file, "alpha_wall", job.model.wall.alpha);
-    h5::write_attribute(file, "e_floor", job.model.floor.e);
-    h5::write_attribute(file, "alpha_floor", job.model.floor.alpha);
+    // A swept coefficient has no single value: its attribute names the axis instead
+    // ("axis:e"), and `swept` lists the coefficient axes.
+    const std::pair<const char*, double> coefficients[] = {{"e_wall", job.model.wall.e},
+                                                           {"alpha_wall", job.model.wall.alpha},
+                                                           {"e_floor", job.model.floor.e},
+                                                           {"alpha_floor", job.model.floor.alpha}};
+    for (std::size_t c = 0; c < 4; ++c) {
+        const auto [key, value] = coefficients[c];
+        if (job.swept[c] < 0) {
+            h5::write_attribute(file, key, value);
+        } else {
+            h5::write_attribute(file, key, "axis:" + job.parameters[static_cast<std::size_t>(job.swept[c])].name);
+        }
+    }
+    if (!job.parameters.empty()) {
+        std::vector<std::string> swept;
+        for (const Coordinate& p : job.parameters) swept.push_back(p.name);
+        h5::write_attribute(file, "swept", swept);
+    }
     if (job.coordinates == Coordinates::physical) {
         h5::write_attribute(file, "g", job.frame.g);
         h5::write_attribute(file, "radius", job.frame.radius);

@@ -211,6 +211,42 @@ class Explore(unittest.TestCase):
             self.assertEqual(f["wall_bounces"].dtype, np.uint32)  # max_bounces > 65535
         self.assertFalse(os.path.exists(self.path("line.xmf")))
 
+    def test_swept_coefficient(self):
+        """alpha as a range axis (before the coordinates): each slice equals a run at that
+        alpha, and the layout says which axis sets which coefficient."""
+        grid = 'xi = { min = 0.0, max = 1.0, n = 40 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 30 }'
+        job = self.write_job(job_text(grid, model="e = 0.9\nalpha = { min = 0.5, max = 1.0, n = 5 }\ne_floor = 0.8"))
+        out = self.path("sweep.h5")
+        self.explore(job, out, 3)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f["wall_bounces"].shape, (5, 40, 30))
+            self.assertEqual(list(f.attrs["axis_names"]), ["alpha", "xi", "W"])
+            self.assertEqual(list(f.attrs["swept"]), ["alpha"])
+            self.assertEqual(f.attrs["alpha_wall"], "axis:alpha")
+            self.assertEqual(f.attrs["alpha_floor"], "axis:alpha")
+            self.assertEqual(f.attrs["e_wall"], 0.9)
+            self.assertEqual(f.attrs["e_floor"], 0.8)
+            alphas = f["axes/alpha"][()]
+            wb, oc = f["wall_bounces"][()], f["outcome"][()]
+        np.testing.assert_array_equal(alphas, [0.5 + (i + 0.5) * 0.5 / 5 for i in range(5)])
+        for i, alpha in enumerate(alphas):
+            single = self.write_job(job_text(grid, model=f"e = 0.9\nalpha = {alpha!r}\ne_floor = 0.8"), f"a{i}.toml")
+            self.explore(single, self.path(f"a{i}.h5"), 1)
+            w1, o1 = self.datasets(self.path(f"a{i}.h5"))
+            np.testing.assert_array_equal(wb[i], w1)
+            np.testing.assert_array_equal(oc[i], o1)
+        # Only coefficients as axes: e x alpha at one start point.
+        job = self.write_job(job_text("xi = 0.05\nU = -1.0\nW = -2.0",
+                                      model="e = { min = 0.5, max = 1.0, n = 7 }\nalpha = { min = 0.0, max = 1.0, n = 9 }"),
+                             "ea.toml")
+        self.explore(job, self.path("ea.h5"), 2)
+        with h5py.File(self.path("ea.h5"), "r") as f:
+            e, a, w = f["axes/e"][()], f["axes/alpha"][()], f["wall_bounces"][()]
+        for i, k in [(0, 0), (3, 8), (6, 4)]:
+            r = subprocess.run([SUPERBALL, "count", "--json", "--e", repr(float(e[i])), "--alpha", repr(float(a[k])),
+                                "--xi", "0.05", "--U", "-1", "--W", "-2"], capture_output=True, text=True, check=True)
+            self.assertEqual(json.loads(r.stdout)["wall_bounces"], int(w[i, k]))
+
     def test_refine(self):
         """Adaptive refinement: the same file for any rank count, close to the full
         computation, exact where the grid is uniform, and recorded in the file."""

@@ -517,4 +517,90 @@ TEST(Fingerprint, CanonicalOmitsFrame)
 }
 
 }  // namespace
+// --- Swept coefficients (issue 6) --------------------------------------------------------
+
+namespace {
+
+std::string sweep_job(const std::string& model, const std::string& grid)
+{
+    return "[model]\n" + model + "\n[grid]\n" + grid;
+}
+
+const std::string one_coordinate_range = "xi = { min = 0, max = 1, n = 8 }\nU = -1\nW = 0\n";
+
+}  // namespace
+
+TEST(Sweep, CoefficientRangeIsAnAxisBeforeTheCoordinates)
+{
+    const Job job = parse_job(sweep_job("e = 0.9\nalpha = { min = 0.5, max = 1, n = 4 }\ne_floor = 0.8\n", one_coordinate_range),
+                              source);
+    ASSERT_EQ(job.parameters.size(), 1u);
+    EXPECT_EQ(job.parameters[0].name, "alpha");
+    const auto axes = job.range_axes();
+    ASSERT_EQ(axes.size(), 2u);
+    EXPECT_EQ(axes[0]->name, "alpha");
+    EXPECT_EQ(axes[1]->name, "xi");
+    EXPECT_EQ(job.points(), 32u);
+    // alpha sets both surfaces' alpha; e_wall comes from e, e_floor is fixed.
+    EXPECT_EQ(job.swept, (std::array<int, 4>{-1, 0, -1, 0}));
+    const double value[] = {0.7};
+    const Model m = job.model_at(value);
+    EXPECT_EQ(m.wall.alpha, 0.7);
+    EXPECT_EQ(m.floor.alpha, 0.7);
+    EXPECT_EQ(m.wall.e, 0.9);
+    EXPECT_EQ(m.floor.e, 0.8);
+}
+
+TEST(Sweep, PerSurfaceRangeOverridesSharedValue)
+{
+    const Job job = parse_job(
+        sweep_job("e = 0.9\nalpha = 0.9\ne_wall = { min = 0.2, max = 0.4, n = 3 }\n", one_coordinate_range), source);
+    EXPECT_EQ(job.swept, (std::array<int, 4>{0, -1, -1, -1}));
+    const double value[] = {0.3};
+    EXPECT_EQ(job.model_at(value).wall.e, 0.3);
+    EXPECT_EQ(job.model_at(value).floor.e, 0.9);
+}
+
+TEST(Sweep, OnlyCoefficientAxes)
+{
+    const Job job = parse_job(sweep_job("e = { min = 0.5, max = 1, n = 3 }\nalpha = { min = 0, max = 1, n = 5 }\n",
+                                        "xi = 0.05\nU = -1\nW = -2\n"),
+                              source);
+    EXPECT_EQ(job.points(), 15u);
+    EXPECT_EQ(job.range_axes().size(), 2u);
+}
+
+TEST(Sweep, FingerprintIncludesTheSweep)
+{
+    const std::string a = sweep_job("e = 0.9\nalpha = { min = 0.5, max = 1, n = 4 }\n", one_coordinate_range);
+    const std::string b = sweep_job("e = 0.9\nalpha = { min = 0.5, max = 1, n = 5 }\n", one_coordinate_range);
+    EXPECT_NE(fingerprint(parse_job(a, source)), fingerprint(parse_job(b, source)));
+}
+
+TEST(Sweep, Errors)
+{
+    const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+        // A range end out of the physical range names the end.
+        {sweep_job("e = 0.9\nalpha = { min = 0.5, max = 1.5, n = 4 }\n", one_coordinate_range),
+         {"[model] alpha.max = 1.5", "-1 <= alpha <= 1"}},
+        {sweep_job("e = { min = 0, max = 1, n = 4 }\nalpha = 0.5\n", one_coordinate_range), {"[model] e.min = 0", "0 < e <= 1"}},
+        {sweep_job("e = 0.9\nalpha = { min = 0.5, max = 0.5, n = 4 }\n", one_coordinate_range), {"[model] alpha", "min < max"}},
+        {sweep_job("e = 0.9\nalpha = { min = 0.1, max = 0.5, n = 0 }\n", one_coordinate_range), {"[model] alpha.n"}},
+        {sweep_job("e = 0.9\nalpha = { min = 0.1, max = 0.5, n = 4, step = 1 }\n", one_coordinate_range),
+         {"[model] alpha.step"}},
+        // Shadowed: nothing would follow e.
+        {sweep_job("e = { min = 0.5, max = 1, n = 4 }\nalpha = 0.5\ne_wall = 0.9\ne_floor = 0.9\n", one_coordinate_range),
+         {"[model] e is a range", "nothing would follow it"}},
+        // Five range axes.
+        {sweep_job("e = { min = 0.5, max = 1, n = 2 }\nalpha = { min = 0, max = 1, n = 2 }\n",
+                   "xi = { min = 0, max = 1, n = 2 }\nU = { min = -2, max = -1, n = 2 }\nW = { min = -1, max = 1, n = 2 }\n"),
+         {"5 range axes", "at most 4"}},
+    };
+    for (const auto& [text, needles] : cases) {
+        const std::string message = error_of(text);
+        ASSERT_FALSE(message.empty()) << text;
+        for (const std::string& needle : needles) EXPECT_NE(message.find(needle), std::string::npos) << message;
+    }
+}
+
 }  // namespace superball

@@ -1,0 +1,249 @@
+// superball fixed-points: fixed points and cycles of the canonical map G (self-similar
+// motions), by Newton's method from many seeded starts, split across MPI ranks.
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "core/dynamics.hpp"
+#include "explore/mpi.hpp"
+#include "options.hpp"
+
+namespace superball::cli {
+
+namespace {
+
+constexpr int max_period_limit = 8;
+
+struct FixedPointOptions {
+    ModelInput model;
+    int period = 1;
+    std::int64_t starts = 2000;
+    std::uint64_t seed = 1;
+    std::string format = "table";
+    std::string output;
+    bool corner = false;
+};
+
+void validate(const FixedPointOptions& opt)
+{
+    if (opt.period < 1 || opt.period > max_period_limit) {
+        throw InputError(fmt::format("--period = {} is out of range: accepted 1..{}", opt.period, max_period_limit));
+    }
+    if (opt.starts < 1) throw InputError(fmt::format("--starts = {} is out of range: accepted starts >= 1", opt.starts));
+    if (opt.format != "table" && opt.format != "json") {
+        throw InputError("--format = " + opt.format + " is not a format: accepted table or json");
+    }
+}
+
+// Newton's method converged from start `start` for G^`k` at `point`.
+struct Hit {
+    std::uint64_t start;
+    int k;
+    Domain domain;
+    CanonicalState<double> point;
+};
+
+constexpr int hit_doubles = 6;
+
+// This rank's share of the starts: every rank draws the whole sequence (cheap next to
+// Newton's method) and keeps the indices i = rank mod size, so the starts, and the order
+// in which rank 0 examines what they found, are those of a serial run.
+std::vector<double> search(const ModelMatrices& m, const FixedPointOptions& opt, int rank, int size)
+{
+    std::vector<double> hits;
+    SeededStarts draw(opt.seed);
+    for (std::int64_t i = 0; i < opt.starts; ++i) {
+        const CanonicalState<double> start = draw.next();
+        if (i % size != rank) continue;
+        for (int k = 1; k <= opt.period; ++k) {
+            for (const Domain domain : {Domain::interior, Domain::corner}) {
+                if (domain == Domain::corner && !opt.corner) continue;
+                if (const auto p = newton_cycle(start, m, k, domain)) {
+                    hits.insert(hits.end(), {static_cast<double>(i), static_cast<double>(k),
+                                             static_cast<double>(domain), p->xi, p->U, p->W});
+                }
+            }
+        }
+    }
+    return hits;
+}
+
+// Every rank's hits on rank 0 (empty elsewhere).
+std::vector<double> gather(const mpi::Comm& comm, const std::vector<double>& mine)
+{
+    const int size = comm.size();
+    const int n = static_cast<int>(mine.size());
+    std::vector<int> counts(comm.is_root() ? static_cast<std::size_t>(size) : 0);
+    mpi::check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm.get()), "MPI_Gather");
+    std::vector<int> offsets(counts.size());
+    std::vector<double> all;
+    if (comm.is_root()) {
+        int total = 0;
+        for (std::size_t r = 0; r < counts.size(); ++r) {
+            offsets[r] = total;
+            total += counts[r];
+        }
+        all.resize(static_cast<std::size_t>(total));
+    }
+    mpi::check(MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0,
+                           comm.get()),
+               "MPI_Gatherv");
+    return all;
+}
+
+std::vector<Hit> unpack(const std::vector<double>& data)
+{
+    std::vector<Hit> hits;
+    for (std::size_t i = 0; i + hit_doubles <= data.size(); i += hit_doubles) {
+        hits.push_back({static_cast<std::uint64_t>(data[i]), static_cast<int>(data[i + 1]),
+                        static_cast<Domain>(static_cast<int>(data[i + 2])), {data[i + 3], data[i + 4], data[i + 5]}});
+    }
+    // Serial order: by start, then period, then domain. distinct_cycles keeps the first of
+    // repeated cycles, so the output does not depend on the number of ranks.
+    std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) {
+        if (a.start != b.start) return a.start < b.start;
+        if (a.k != b.k) return a.k < b.k;
+        return a.domain < b.domain;
+    });
+    return hits;
+}
+
+std::string eigenvalue_text(const std::complex<double>& z)
+{
+    if (z.imag() == 0.0) return fmt::format("{:.10g}", z.real());
+    return fmt::format("{:.10g}{:+.10g}i", z.real(), z.imag());
+}
+
+void write_table(std::FILE* f, const std::vector<Cycle>& cycles, const Model& model, const FixedPointOptions& opt,
+                 int ranks)
+{
+    fmt::print(f, "# superball fixed-points: e_wall {} alpha_wall {} e_floor {} alpha_floor {}\n", model.wall.e,
+               model.wall.alpha, model.floor.e, model.floor.alpha);
+    fmt::print(f, "# periods 1..{}{}, {} Newton starts (seed {}) on {} rank{}: {} cycle{}\n", opt.period,
+               opt.corner ? " (also on the corner plane xi = 0)" : "", opt.starts, opt.seed, ranks, ranks == 1 ? "" : "s",
+               cycles.size(), cycles.size() == 1 ? "" : "s");
+    fmt::print(f, "# (xi, U, W): the point of the cycle with the smallest xi; lambda: product of the multipliers\n"
+                  "# over the cycle; eig1..3: eigenvalues of the Jacobian of G^period; family: eigenvalue 1,\n"
+                  "# the cycle belongs to a continuous family; corner: on the plane xi = 0\n");
+    fmt::print(f, "{:>6} {:>23} {:>23} {:>23} {:>20} {:>36} {:>36} {:>36} {:>9} {:>6} {:>6}\n", "period", "xi", "U", "W",
+               "lambda", "eig1", "eig2", "eig3", "stability", "family", "corner");
+    for (const Cycle& c : cycles) {
+        const CanonicalState<double>& p = c.points.front();
+        fmt::print(f, "{:>6} {:>23.16g} {:>23.16g} {:>23.16g} {:>20.14g} {:>36} {:>36} {:>36} {:>9} {:>6} {:>6}\n",
+                   c.period, p.xi, p.U, p.W, c.lambda, eigenvalue_text(c.eigenvalues[0]),
+                   eigenvalue_text(c.eigenvalues[1]), eigenvalue_text(c.eigenvalues[2]), name(c.stability),
+                   c.family ? "yes" : "no", c.corner ? "yes" : "no");
+    }
+}
+
+// Doubles as the shortest text that reads back to the same value (fmt's "{}").
+void write_json(std::FILE* f, const std::vector<Cycle>& cycles, const Model& model, const FixedPointOptions& opt,
+                int ranks)
+{
+    fmt::print(f, "{{\n  \"model\": {{\"e_wall\": {}, \"alpha_wall\": {}, \"e_floor\": {}, \"alpha_floor\": {}}},\n",
+               model.wall.e, model.wall.alpha, model.floor.e, model.floor.alpha);
+    fmt::print(f, "  \"max_period\": {}, \"starts\": {}, \"seed\": {}, \"corner_search\": {}, \"ranks\": {},\n",
+               opt.period, opt.starts, opt.seed, opt.corner, ranks);
+    fmt::print(f, "  \"residual_tolerance\": {}, \"marginal_tolerance\": {},\n  \"cycles\": [", residual_tolerance,
+               marginal_tolerance);
+    const char* sep = "\n";
+    for (const Cycle& c : cycles) {
+        const CanonicalState<double>& p = c.points.front();
+        fmt::print(f, "{}    {{\"period\": {}, \"xi\": {}, \"U\": {}, \"W\": {}, \"lambda\": {}, \"stability\": \"{}\", "
+                      "\"family\": {}, \"corner\": {}, \"residual\": {},\n",
+                   sep, c.period, p.xi, p.U, p.W, c.lambda, name(c.stability), c.family, c.corner, c.residual);
+        fmt::print(f, "     \"eigenvalues\": [");
+        for (std::size_t i = 0; i < c.eigenvalues.size(); ++i) {
+            fmt::print(f, "{}{{\"re\": {}, \"im\": {}}}", i ? ", " : "", c.eigenvalues[i].real(), c.eigenvalues[i].imag());
+        }
+        fmt::print(f, "],\n     \"points\": [");
+        for (std::size_t i = 0; i < c.points.size(); ++i) {
+            fmt::print(f, "{}{{\"xi\": {}, \"U\": {}, \"W\": {}}}", i ? ", " : "", c.points[i].xi, c.points[i].U,
+                       c.points[i].W);
+        }
+        fmt::print(f, "]}}");
+        sep = ",\n";
+    }
+    fmt::print(f, "\n  ]\n}}\n");
+}
+
+int run(const FixedPointOptions& opt)
+{
+    const mpi::Environment env;
+    const mpi::Comm world = mpi::Comm::world();
+    Model model;
+    try {
+        model = resolve_model(opt.model, flag_spelling);
+        validate(opt);
+    } catch (const InputError& e) {
+        // Every rank checks the same flags and gets the same verdict: one message is enough.
+        if (world.is_root()) fmt::print(stderr, "superball fixed-points: {}\n", e.what());
+        return 2;
+    }
+    const ModelMatrices m = ModelMatrices::of(model);
+    std::vector<double> all;
+    try {
+        all = gather(world, search(m, opt, world.rank(), world.size()));
+    } catch (const std::exception& e) {
+        // The other ranks would wait in the gather for ever: end them all.
+        fmt::print(stderr, "superball fixed-points (rank {}): error: {}\n", world.rank(), e.what());
+        world.abort(1);
+    }
+    if (!world.is_root()) return 0;
+
+    std::vector<Cycle> found;
+    for (const Hit& h : unpack(all)) {
+        if (auto c = make_cycle(h.point, m, h.k, h.domain)) found.push_back(std::move(*c));
+    }
+    const std::vector<Cycle> cycles = distinct_cycles(found);
+
+    std::FILE* f = stdout;
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
+    if (!opt.output.empty()) {
+        file.reset(std::fopen(opt.output.c_str(), "w"));
+        if (!file) throw std::runtime_error("cannot write " + opt.output);
+        f = file.get();
+    }
+    if (opt.format == "json") {
+        write_json(f, cycles, model, opt, world.size());
+    } else {
+        write_table(f, cycles, model, opt, world.size());
+    }
+    if (file && std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + opt.output);
+    return 0;
+}
+
+}  // namespace
+
+Runner add_fixed_points_command(CLI::App& app)
+{
+    auto* sub = app.add_subcommand("fixed-points", "Fixed points and cycles of the canonical map (self-similar motions)");
+    sub->footer(
+        "Solves G^k(s) = s for k = 1..--period by damped Newton's method from --starts seeded starts in\n"
+        "0 < xi < 1, U < 0, keeping the solutions whose whole cycle stays there (residual <= 1e-10).\n"
+        "For each distinct cycle: its period, the point with the smallest xi, the product lambda of the\n"
+        "multipliers (scale factor per period), the eigenvalues of the Jacobian of G^k and the stability\n"
+        "(stable, unstable, saddle, marginal: some |eigenvalue| within 1e-9 of 1). Under mpirun the starts\n"
+        "are shared among the ranks; the result does not depend on their number.\n"
+        "--corner also looks for cycles on the corner plane xi = 0, where the wall sends the ball down\n"
+        "and G maps the plane into itself: the limits of motions that go into the corner. Their\n"
+        "eigenvalues include the transverse multiplier kappa = d xi'/d xi (< 1: nearby launches approach\n"
+        "the corner, with infinitely many bounces).\n"
+        "Example: superball fixed-points --e 0.9 --alpha 1 --period 3 --format json");
+    auto opt = std::make_shared<FixedPointOptions>();
+    add_model_flags(*sub, opt->model);
+    sub->add_option("--period", opt->period, "largest period k to look for, 1..8")->capture_default_str();
+    sub->add_option("--starts", opt->starts, "number of Newton starts, >= 1")->capture_default_str();
+    sub->add_option("--seed", opt->seed, "seed of the random starts (std::mt19937_64)")->capture_default_str();
+    sub->add_option("--format", opt->format, "table or json")->capture_default_str();
+    sub->add_option("-o,--output", opt->output, "write to this file instead of standard output");
+    sub->add_flag("--corner", opt->corner, "also look for cycles on the corner plane xi = 0");
+    return [opt] { return run(*opt); };
+}
+
+}  // namespace superball::cli
