@@ -40,26 +40,6 @@ Slice parse_slice(const std::string& text)
     return {text.substr(0, eq), std::stoull(index)};
 }
 
-std::string json_string(const std::string& s)
-{
-    std::string out = "\"";
-    for (const char c : s) {
-        switch (c) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20) {
-                    out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-                } else {
-                    out += c;
-                }
-        }
-    }
-    return out + "\"";
-}
-
 // JSON has no NaN: an estimate that could not be made is null.
 std::string json_number(double x) { return std::isfinite(x) ? fmt::format("{}", x) : "null"; }
 
@@ -87,11 +67,11 @@ void print_json(const std::string& file, const ResultPlane& plane, const std::op
 {
     const ClassRule rule = s.settings.rule;
     fmt::print("{{\n");
-    fmt::print("  \"file\": {},\n", json_string(file));
+    fmt::print("  \"file\": {},\n", quote(file));
     fmt::print("  \"rows\": {}, \"cols\": {}, \"row_axis\": {}, \"col_axis\": {},\n", s.rows, s.cols,
-               json_string(plane.row_axis), json_string(plane.col_axis));
+               quote(plane.row_axis), quote(plane.col_axis));
     if (slice) {
-        fmt::print("  \"slice\": {{\"axis\": {}, \"index\": {}}},\n", json_string(plane.sliced_axis), slice->index);
+        fmt::print("  \"slice\": {{\"axis\": {}, \"index\": {}}},\n", quote(plane.sliced_axis), slice->index);
     } else {
         fmt::print("  \"slice\": null,\n");
     }

@@ -67,6 +67,14 @@ struct StartsView {
 struct Starts {
     std::vector<double> xi, U, W;
 
+    static Starts of(std::span<const CanonicalState<double>> states)
+    {
+        Starts out;
+        out.reserve(states.size());
+        for (const CanonicalState<double>& c : states) out.push_back(c);
+        return out;
+    }
+
     std::size_t size() const { return xi.size(); }
     void clear()
     {

@@ -1,6 +1,7 @@
 #include "input.hpp"
 
 #include <charconv>
+#include <cstdio>
 
 namespace superball {
 
@@ -9,6 +10,28 @@ std::string format_double(double x)
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, x);
     return {buf, r.ptr};
+}
+
+std::string quote(std::string_view s)
+{
+    std::string out = "\"";
+    for (const char c : s) {
+        switch (c) {
+            case '"': out += "\\\""; break;
+            case '\\': out += "\\\\"; break;
+            case '\n': out += "\\n"; break;
+            case '\t': out += "\\t"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+                    char buf[8];
+                    std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+                    out += buf;
+                } else {
+                    out += c;
+                }
+        }
+    }
+    return out + "\"";
 }
 
 namespace {

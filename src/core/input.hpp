@@ -33,4 +33,8 @@ Model resolve_model(const ModelInput& in, const KeySpelling& spell);
 // Shortest text that reads back as the same double (for messages and attributes).
 std::string format_double(double x);
 
+// `s` in double quotes with \" \\ \n \t and \u00XX escapes: a JSON string and a TOML basic
+// string alike (for messages that quote user text, and JSON output).
+std::string quote(std::string_view s);
+
 }  // namespace superball

@@ -80,28 +80,6 @@ std::string type_name(const toml::node& n)
     return "nothing";
 }
 
-std::string toml_string(std::string_view s)
-{
-    std::string out = "\"";
-    for (const char c : s) {
-        switch (c) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
-            default:
-                if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-                    char buf[8];
-                    std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-                    out += buf;
-                } else {
-                    out += c;
-                }
-        }
-    }
-    return out + "\"";
-}
-
 // TOML tells floats from integers by the spelling: keep "2.0" from reading as "2", since
 // the message may be complaining that it is not an integer.
 std::string float_text(double x)
@@ -113,7 +91,7 @@ std::string float_text(double x)
 
 std::string as_written(const toml::node& n)
 {
-    if (const auto* s = n.as_string()) return toml_string(s->get());
+    if (const auto* s = n.as_string()) return quote(s->get());
     if (const auto* i = n.as_integer()) return std::to_string(i->get());
     if (const auto* f = n.as_floating_point()) return float_text(f->get());
     if (const auto* b = n.as_boolean()) return b->get() ? "true" : "false";

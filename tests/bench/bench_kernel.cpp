@@ -16,12 +16,6 @@ namespace {
 
 using namespace superball;
 
-Starts soa(const std::vector<CanonicalState<double>>& s)
-{
-    Starts out;
-    for (const auto& c : s) out.push_back(c);
-    return out;
-}
 
 const ModelMatrices slice_model = ModelMatrices::of(Model::uniform(0.9, 0.9));
 
@@ -67,14 +61,14 @@ void BM_physical_map(benchmark::State& state)
 }
 BENCHMARK(BM_physical_map);
 
+// Counts every start once per iteration with the scalar or the vectorised kernel;
+// items are points, and the counter the time per iteration of G.
 template <bool simd>
-void BM_count_slice(benchmark::State& state)
+void run_kernel(benchmark::State& state, const std::vector<CanonicalState<double>>& starts)
 {
-    const auto n = static_cast<std::size_t>(state.range(0));
-    const auto starts = slice(n);
     std::vector<std::uint32_t> wb(starts.size());
     std::vector<std::uint8_t> oc(starts.size());
-    const Starts points = soa(starts);
+    const Starts points = Starts::of(starts);
     for (auto _ : state) {
         if constexpr (simd) {
             count_each_simd(points.view(), slice_model, 1000, wb, oc);
@@ -89,6 +83,12 @@ void BM_count_slice(benchmark::State& state)
     state.counters["time_per_map_iteration"] = benchmark::Counter(
         static_cast<double>(state.iterations() * iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
+
+template <bool simd>
+void BM_count_slice(benchmark::State& state)
+{
+    run_kernel<simd>(state, slice(static_cast<std::size_t>(state.range(0))));
+}
 // 4096: the full benchmark slice of tests/bench/run.sh (16.7 M points).
 BENCHMARK_TEMPLATE(BM_count_slice, false)->Arg(512)->Arg(4096)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_count_slice, true)->Arg(512)->Arg(4096)->Unit(benchmark::kMillisecond);
@@ -102,22 +102,7 @@ void BM_count_long_lived(benchmark::State& state)
     for (int i = 0; i < 64; ++i) {
         for (int k = 0; k < 64; ++k) starts.push_back({0.0005 + 0.0007 * i, -1.0, -2.99 + 0.015 * k});
     }
-    std::vector<std::uint32_t> wb(starts.size());
-    std::vector<std::uint8_t> oc(starts.size());
-    const Starts points = soa(starts);
-    for (auto _ : state) {
-        if constexpr (simd) {
-            count_each_simd(points.view(), slice_model, 1000, wb, oc);
-        } else {
-            count_each(points.view(), slice_model, 1000, wb, oc);
-        }
-        benchmark::ClobberMemory();
-    }
-    std::uint64_t iterations = 0;
-    for (const auto w : wb) iterations += w;
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * starts.size()));
-    state.counters["time_per_map_iteration"] = benchmark::Counter(
-        static_cast<double>(state.iterations() * iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    run_kernel<simd>(state, starts);
 }
 BENCHMARK_TEMPLATE(BM_count_long_lived, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_count_long_lived, true)->Unit(benchmark::kMillisecond);

@@ -13,12 +13,6 @@ namespace {
 
 using namespace superball;
 
-Starts soa(const std::vector<CanonicalState<double>>& s)
-{
-    Starts out;
-    for (const auto& c : s) out.push_back(c);
-    return out;
-}
 
 struct Counts {
     std::vector<std::uint32_t> wall_bounces;
@@ -28,7 +22,7 @@ struct Counts {
 Counts scalar(const std::vector<CanonicalState<double>>& s, const Model& model, std::uint32_t max)
 {
     Counts c{std::vector<std::uint32_t>(s.size()), std::vector<std::uint8_t>(s.size())};
-    count_each(soa(s).view(), ModelMatrices::of(model), max, c.wall_bounces, c.outcomes);
+    count_each(Starts::of(s).view(), ModelMatrices::of(model), max, c.wall_bounces, c.outcomes);
     return c;
 }
 
@@ -36,7 +30,7 @@ Counts simd(const std::vector<CanonicalState<double>>& s, const Model& model, st
 {
     // Poisoned outputs: every point must be written.
     Counts c{std::vector<std::uint32_t>(s.size(), 0xdeadbeef), std::vector<std::uint8_t>(s.size(), 0xff)};
-    count_each_simd(soa(s).view(), ModelMatrices::of(model), max, c.wall_bounces, c.outcomes);
+    count_each_simd(Starts::of(s).view(), ModelMatrices::of(model), max, c.wall_bounces, c.outcomes);
     return c;
 }
 

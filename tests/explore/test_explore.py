@@ -17,35 +17,11 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import mpi_env, descendants  # noqa: E402
+
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
-
-
-def mpi_env():
-    env = dict(os.environ)
-    if os.geteuid() == 0:  # Open MPI refuses root unless told
-        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    return env
-
-
-def descendants(pid):
-    """Every process below `pid`: Open MPI puts its ranks in process groups of their own,
-    so killing mpirun's group does not reach them."""
-    children = {}
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/stat") as f:
-                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
-            except (OSError, IndexError, ValueError):
-                continue
-            children.setdefault(ppid, []).append(int(entry))
-    found, todo = [], [pid]
-    while todo:
-        for child in children.get(todo.pop(), []):
-            found.append(child)
-            todo.append(child)
-    return found
 
 
 def job_text(grid, model="e = 0.9\nalpha = 0.9", run="max_bounces = 1000"):

@@ -18,6 +18,9 @@ import unittest
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import superball_binary, mpi_env  # noqa: E402
+
 SOURCE = os.path.abspath(os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", ".."))
 JOBS = os.path.join(SOURCE, "jobs")
 
@@ -40,24 +43,6 @@ CATALOGUE = [
 QUICK_SECONDS = 30
 QUICK_MAX_POINTS = {2: 256 * 256, 3: 64**3}
 FULL_MIN_POINTS = {2: 4096 * 4096, 3: 512**3}
-
-
-def superball_binary():
-    path = os.environ.get("SUPERBALL")
-    if path:
-        return os.path.abspath(path)
-    for build in ("build/release", "build/native"):
-        candidate = os.path.join(SOURCE, build, "src", "superball")
-        if os.access(candidate, os.X_OK):
-            return candidate
-    raise unittest.SkipTest("no superball binary: set SUPERBALL")
-
-
-def mpi_env():
-    env = dict(os.environ)
-    if os.getuid() == 0:
-        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    return env
 
 
 @functools.lru_cache(maxsize=None)

@@ -12,12 +12,16 @@ is stopped at the end when this test started it; SUPERBALL_KEEP_SLURM=1 keeps it
 import os
 import re
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import superball_binary  # noqa: E402
 
 SOURCE = os.path.abspath(os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", ".."))
 CLUSTER = os.path.join(SOURCE, "tests", "jobs", "slurm_cluster.sh")
@@ -62,17 +66,6 @@ output = "out/slow.h5"
 
 cluster_env = {}
 started_here = False
-
-
-def superball_binary():
-    path = os.environ.get("SUPERBALL")
-    if path:
-        return os.path.abspath(path)
-    for build in ("build/release", "build/native"):
-        candidate = os.path.join(SOURCE, build, "src", "superball")
-        if os.access(candidate, os.X_OK):
-            return candidate
-    raise unittest.SkipTest("no superball binary: set SUPERBALL")
 
 
 def setUpModule():
