@@ -125,6 +125,7 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
                job.model.floor.e, job.model.floor.alpha);
     fmt::print("points: {}\nmax_bounces: {}\n", job.points(), job.max_bounces);
     if (job.refine != 0) fmt::print("refine: coarse stride {}\n", job.refine);
+    if (Grid(job).on_boundary_plane()) fmt::print("boundary plane: xi = {} (limits from inside)\n", *job.grid[0].fixed);
     const Tiling tiling = default_tiling(job, ranks);
     fmt::print("tiles: {} of up to {} points for {} rank{}\n", tiling.tiles(), tiling.box(0).points(), ranks,
                ranks == 1 ? "" : "s");
@@ -201,7 +202,10 @@ int explore(const ExploreOptions& opt)
         std::vector<std::uint8_t> outcomes;
         std::vector<std::uint64_t> histogram(outcome_count, 0);
         std::uint64_t computed = 0;  // points counted by the kernel (fewer than the tiles' with refinement)
-        TileCounter counter(opt.kernel == "scalar" ? &count_each : &count_each_simd, job.max_bounces);
+        const CountKernel kernel = grid.on_boundary_plane() ? &count_each_on_plane
+                                   : opt.kernel == "scalar"    ? &count_each
+                                                               : &count_each_simd;
+        TileCounter counter(kernel, job.max_bounces);
         std::vector<ModelRun> runs;
         const TileWork work = [&](std::uint64_t t, const Serve& serve) {
             const Box box = tiling.box(t);

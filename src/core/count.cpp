@@ -1,5 +1,7 @@
 #include "count.hpp"
 
+#include <cmath>
+
 namespace superball {
 
 std::optional<Outcome> outcome_from_name(std::string_view s)
@@ -11,11 +13,11 @@ std::optional<Outcome> outcome_from_name(std::string_view s)
     return std::nullopt;
 }
 
-BounceCount count(const CanonicalState<double>& start, const ModelMatrices& m, std::uint32_t max_bounces)
+namespace {
+
+// The loop of SPEC.md section 3 from state c after n wall impacts.
+BounceCount iterate(CanonicalState<double> c, std::uint32_t n, const ModelMatrices& m, std::uint32_t max_bounces)
 {
-    if (!is_launch(start)) return {0, Outcome::invalid};
-    CanonicalState<double> c = start;
-    std::uint32_t n = 0;
     for (;;) {
         // Written as !(xi < 1) so that a state that has lost all meaning (NaN) stops as a
         // miss instead of running to max_bounces.
@@ -26,6 +28,36 @@ BounceCount count(const CanonicalState<double>& start, const ModelMatrices& m, s
         c = canonical_map(c, m).next;
         ++n;
         if (c.U >= 0.0) return {n, Outcome::left};
+    }
+}
+
+}  // namespace
+
+BounceCount count(const CanonicalState<double>& start, const ModelMatrices& m, std::uint32_t max_bounces)
+{
+    if (!is_launch(start)) return {0, Outcome::invalid};
+    return iterate(start, 0, m, max_bounces);
+}
+
+BounceCount count_on_plane(const CanonicalState<double>& start, const ModelMatrices& m, std::uint32_t max_bounces)
+{
+    const bool plane = start.xi == 0.0 || start.xi == 1.0;
+    if (!plane || !std::isfinite(start.U) || !std::isfinite(start.W) || !(start.U < 0.0)) return {0, Outcome::invalid};
+    if (max_bounces == 0) return {0, Outcome::capped};
+    // G evaluated on the plane is its limit from inside (core/boundary_planes.md): the
+    // first excursion is taken even at xi = 1, where count() would report a miss.
+    const CanonicalState<double> c = canonical_map(start, m).next;
+    if (c.U >= 0.0) return {1, Outcome::left};
+    return iterate(c, 1, m, max_bounces);
+}
+
+void count_each_on_plane(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
+                         std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
+{
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        const BounceCount r = count_on_plane(starts[i], m, max_bounces);
+        wall_bounces[i] = r.wall_bounces;
+        outcomes[i] = static_cast<std::uint8_t>(r.outcome);
     }
 }
 

@@ -114,6 +114,15 @@ struct Starts {
 void count_each(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                 std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes);
 
+// The limit of count() as xi -> 0+ or xi -> 1-, for starts on a boundary plane (xi
+// exactly 0 or 1; anything else is invalid): the first excursion is G's limit there.
+BounceCount count_on_plane(const CanonicalState<double>& start, const ModelMatrices& m, std::uint32_t max_bounces);
+
+// count_on_plane() of every start, with count_each()'s contract (scalar: plane grids are
+// 2-D and cheap).
+void count_each_on_plane(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
+                         std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes);
+
 // Physical start: converted to canonical coordinates; not a launch -> invalid.
 BounceCount count(const PhysicalState<double>& start, const Model& m, double g, std::uint32_t max_bounces);
 

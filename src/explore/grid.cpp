@@ -54,6 +54,13 @@ Tiling default_tiling(const Job& job, int ranks)
     return Tiling(shape, default_tile_shape(shape, points));
 }
 
+bool Grid::on_boundary_plane() const
+{
+    if (job_.coordinates != Coordinates::canonical) return false;
+    const std::optional<double>& xi = job_.grid[0].fixed;
+    return xi && (*xi == 0.0 || *xi == 1.0);
+}
+
 Extent Grid::shape() const
 {
     Extent e;

@@ -32,6 +32,11 @@ public:
     // canonical state (NaN), which count() reports as invalid.
     void starts(const Box& box, Starts& out) const;
 
+    // A canonical grid with xi fixed at exactly 0 or 1 lies on a boundary plane: its points
+    // are counted as limits from inside (count_on_plane), not as the invalid launches
+    // (xi = 0) or immediate misses (xi = 1) they would be.
+    bool on_boundary_plane() const;
+
     // The points of `box` grouped by model: one run when no coefficient is swept.
     void model_runs(const Box& box, std::vector<ModelRun>& out) const;
 

@@ -103,3 +103,47 @@ TEST(Kernels, EdgeSizesAndCaps)
 }
 
 }  // namespace
+
+namespace {
+
+// count_on_plane() is the limit of count() from inside: for almost every (U, W) a launch
+// a hair from the plane gives the same count (the exceptions lie on the boundaries of
+// the regions, where the limit itself jumps).
+TEST(BoundaryPlane, CountIsTheLimitFromInside)
+{
+    const ModelMatrices m = ModelMatrices::of(Model::uniform(0.9, 0.9));
+    for (const double plane : {0.0, 1.0}) {
+        const double inside = plane == 0.0 ? 1e-13 : 1.0 - 1e-13;
+        std::size_t same = 0, total = 0, long_lived = 0;
+        for (int i = 0; i < 60; ++i) {
+            for (int k = 0; k < 60; ++k) {
+                const double U = -3.0 + (i + 0.5) * 3.0 / 60, W = -6.0 + (k + 0.5) * 9.0 / 60;
+                const BounceCount on = count_on_plane({plane, U, W}, m, 1000);
+                const BounceCount near = count({inside, U, W}, m, 1000);
+                same += on == near;
+                ++total;
+                long_lived += on.wall_bounces > 5;
+                EXPECT_NE(on.outcome, Outcome::invalid);
+            }
+        }
+        EXPECT_GT(same, total * 99 / 100) << "plane xi = " << plane;
+        if (plane == 0.0) {
+            EXPECT_GT(long_lived, 100u);  // the corner's unstable fixed point draws long motions
+        }
+    }
+    // Off the planes, and non-launches, are invalid; the kernel agrees with the function.
+    EXPECT_EQ(count_on_plane({0.5, -1.0, 0.0}, m, 1000).outcome, Outcome::invalid);
+    EXPECT_EQ(count_on_plane({0.0, 0.5, 0.0}, m, 1000).outcome, Outcome::invalid);
+    EXPECT_EQ(count_on_plane({1.0, -1.0, 0.0}, m, 0), (BounceCount{0, Outcome::capped}));
+    const Starts s = Starts::of(std::vector<CanonicalState<double>>{{0.0, -1.0, -2.5}, {1.0, -0.5, 1.0}, {0.3, -1, 0}});
+    std::vector<std::uint32_t> wb(3);
+    std::vector<std::uint8_t> oc(3);
+    count_each_on_plane(s.view(), m, 1000, wb, oc);
+    for (std::size_t i = 0; i < 3; ++i) {
+        const BounceCount r = count_on_plane(s.view()[i], m, 1000);
+        EXPECT_EQ(wb[i], r.wall_bounces);
+        EXPECT_EQ(oc[i], static_cast<std::uint8_t>(r.outcome));
+    }
+}
+
+}  // namespace

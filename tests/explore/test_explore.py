@@ -205,6 +205,12 @@ class Explore(unittest.TestCase):
             alphas = f["axes/alpha"][()]
             wb, oc = f["wall_bounces"][()], f["outcome"][()]
         np.testing.assert_array_equal(alphas, [0.5 + (i + 0.5) * 0.5 / 5 for i in range(5)])
+        # The sweep plots: a 2-D slice at one alpha.
+        png = self.path("sweep.png")
+        r = subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "..", "..", "analysis", "region_map.py"),
+                            out, "--slice", "alpha=2", "-o", png], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertGreater(os.path.getsize(png), 10000)
         for i, alpha in enumerate(alphas):
             single = self.write_job(job_text(grid, model=f"e = 0.9\nalpha = {alpha!r}\ne_floor = 0.8"), f"a{i}.toml")
             self.explore(single, self.path(f"a{i}.h5"), 1)
@@ -222,6 +228,19 @@ class Explore(unittest.TestCase):
             r = subprocess.run([SUPERBALL, "count", "--json", "--e", repr(float(e[i])), "--alpha", repr(float(a[k])),
                                 "--xi", "0.05", "--U", "-1", "--W", "-2"], capture_output=True, text=True, check=True)
             self.assertEqual(json.loads(r.stdout)["wall_bounces"], int(w[i, k]))
+
+    def test_boundary_plane(self):
+        """A fixed xi of exactly 0 is the plane xi -> 0+: counted as the limit (no invalid
+        points), like launches a hair from the wall; the swept alpha slice plots."""
+        grid = 'xi = 0.0\nU = { min = -3.0, max = -0.01, n = 30 }\nW = { min = -6.0, max = 3.0, n = 40 }'
+        near = grid.replace("xi = 0.0", "xi = 1e-13")
+        self.explore(self.write_job(job_text(grid), "plane.toml"), self.path("plane.h5"), 2)
+        self.explore(self.write_job(job_text(near), "near.toml"), self.path("near.h5"), 2)
+        wp, op = self.datasets(self.path("plane.h5"))
+        wn, on = self.datasets(self.path("near.h5"))
+        self.assertTrue((op != 0).all())
+        self.assertGreater(((wp == wn) & (op == on)).mean(), 0.97)
+        self.assertGreater(wp.max(), 10)
 
     def test_refine(self):
         """Adaptive refinement: the same file for any rank count, close to the full

@@ -37,6 +37,8 @@ CATALOGUE = [
     "canonical_xi_U_W-0",
     "boundary_xi0",
     "boundary_xi1",
+    "plane_xi0",
+    "plane_xi1",
     "volume",
 ]
 # A quick job must finish in seconds on 2 cores; this bound leaves room for a loaded machine.
