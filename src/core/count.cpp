@@ -19,13 +19,15 @@ namespace {
 BounceCount iterate(CanonicalState<double> c, std::uint32_t n, const ModelMatrices& m, std::uint32_t max_bounces)
 {
     for (;;) {
-        // Written as !(xi < 1) so that a state that has lost all meaning (NaN) stops as a
-        // miss instead of running to max_bounces.
+        // xi is never NaN here: a step that could make it so is refused below.
         if (!(c.xi < 1.0)) return {n, Outcome::missed};
         // Capped means the ball would hit the wall once more: a ball whose next
         // excursion misses is reported as missed even at the cap.
         if (n >= max_bounces) return {n, Outcome::capped};
-        c = canonical_map(c, m).next;
+        const CanonicalStep<double> step = canonical_map(c, m);
+        // Overflow or division by zero (map.hpp, representable): no answer, not a miss.
+        if (!representable(step)) return {0, Outcome::invalid};
+        c = step.next;
         ++n;
         if (c.U >= 0.0) return {n, Outcome::left};
     }
@@ -46,7 +48,9 @@ BounceCount count_on_plane(const CanonicalState<double>& start, const ModelMatri
     if (max_bounces == 0) return {0, Outcome::capped};
     // G evaluated on the plane is its limit from inside (core/boundary_planes.md): the
     // first excursion is taken even at xi = 1, where count() would report a miss.
-    const CanonicalState<double> c = canonical_map(start, m).next;
+    const CanonicalStep<double> step = canonical_map(start, m);
+    if (!representable(step)) return {0, Outcome::invalid};
+    const CanonicalState<double> c = step.next;
     if (c.U >= 0.0) return {1, Outcome::left};
     return iterate(c, 1, m, max_bounces);
 }

@@ -45,7 +45,7 @@ struct Results {
 };
 
 // G applied to a batch: the exits of SPEC.md section 3 after the step, in the order
-// count() checks them (left takes precedence over missed over capped).
+// count() checks them (invalid takes precedence over left over missed over capped).
 [[gnu::always_inline]] inline void step(const CanonicalState<Batch>& c, const Batch& count, const ModelMatrices& m, double max_bounces,
           Stepped& next, std::size_t i)
 {
@@ -54,10 +54,16 @@ struct Results {
     stdx::where(count >= max_bounces, exit) = code(Outcome::capped);
     stdx::where(!(s.next.xi < 1.0), exit) = code(Outcome::missed);
     stdx::where(s.next.U >= 0.0, exit) = code(Outcome::left);
+    // Overflow or division by zero (map.hpp, representable): invalid with 0 impacts, as
+    // count() says, before everything else.
+    const auto lost = !representable(s);
+    stdx::where(lost, exit) = code(Outcome::invalid);
+    Batch n = count;
+    stdx::where(lost, n) = 0.0;
     s.next.xi.copy_to(&next.xi[i], stdx::vector_aligned);
     s.next.U.copy_to(&next.U[i], stdx::vector_aligned);
     s.next.W.copy_to(&next.W[i], stdx::vector_aligned);
-    count.copy_to(&next.n[i], stdx::vector_aligned);
+    n.copy_to(&next.n[i], stdx::vector_aligned);
     exit.copy_to(&next.code[i], stdx::vector_aligned);
 }
 

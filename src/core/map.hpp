@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <experimental/simd>
+#include <limits>
 
 #include "impact.hpp"
 #include "state.hpp"
@@ -131,6 +132,21 @@ constexpr CanonicalStep<T> canonical_map(const CanonicalState<T>& c, const Model
     const T U = after_floor.u / lambda;
     // xi' = g x' / (2 |u'| v') with g = 1; |u'| = -u' on the branch where it matters.
     return {{f.x / (-2.0 * after_floor.u * lambda), U, after_floor.W / lambda}, lambda};
+}
+
+// Whether a step of G stayed within double precision: the multiplier is positive and
+// finite, U' and W' are finite, and xi' is a number where it is used (U' < 0). It fails
+// only for starts far outside any physical scale (|U| or |W| beyond about 1e150, where
+// v+^2 overflows, or a subnormal e, where lambda underflows); the counting kernels then
+// report the start invalid instead of reading an overflowed state as a miss or a leave.
+// A mask for SIMD batches. (Sane starts never fail it: tests/core/test_edges.cpp.)
+template <class T>
+auto representable(const CanonicalStep<T>& s)
+{
+    using std::abs;
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    return s.lambda > 0.0 && s.lambda < inf && abs(s.next.U) < inf && abs(s.next.W) < inf &&
+           (s.next.U >= 0.0 || s.next.xi == s.next.xi);
 }
 
 }  // namespace superball
