@@ -46,6 +46,6 @@ with h5py.File(sys.argv[1], "r") as f:
     names, shape = list(f.attrs["axis_names"]), f["wall_bounces"].shape
 print(" ".join(f"--slice {n}={s // 2}" for n, s in zip(names, shape[:max(len(shape) - 2, 0)])))' "$output")
   # shellcheck disable=SC2086  # $slices is a list of options
-  "$python" "$root/analysis/region_map.py" "$output" $slices -o "${output%.h5}.png"
+  "$python" "$root/analysis/region_map.py" "$output" $slices --outcome -o "${output%.h5}.png"
   echo "figure: ${output%.h5}.png"
 fi
