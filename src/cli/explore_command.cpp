@@ -146,6 +146,8 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
 int explore(const ExploreOptions& opt)
 {
     const auto started = std::chrono::steady_clock::now();
+    // Before MPI starts: a signal during start-up then stops the run cleanly too.
+    const StopSignals signals;
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
     const bool root = world.is_root();
@@ -171,7 +173,6 @@ int explore(const ExploreOptions& opt)
         if (root && !d.message.empty() && !opt.quiet) fmt::print(stderr, "{}\n", d.message);
         if (d.mode == Mode::complete) return 0;
 
-        const StopSignals signals;
         const Grid grid(job);
         ResultFile file = d.mode == Mode::fresh ? ResultFile::create(out, world, job, grid, default_tiling(job, world.size()))
                                                 : ResultFile::open(out, world);
@@ -274,7 +275,8 @@ Runner add_explore_command(CLI::App& app)
         "Run as `mpirun -n P superball explore JOB.toml` (P >= 1; every rank computes). The result is one HDF5\n"
         "file (SPEC.md section 5) plus a .xmf sidecar for ParaView. An existing result is never overwritten\n"
         "unless --overwrite is given; --resume finishes an interrupted run of the same job (a different job\n"
-        "is refused). SIGINT/SIGTERM stop cleanly (resumable); a second signal stops at once (still resumable).");
+        "is refused). SIGINT/SIGTERM (or SIGUSR1/2, which mpirun forwards to every rank) stop cleanly\n"
+        "(resumable); a second signal stops at once (still resumable).");
     auto opt = std::make_shared<ExploreOptions>();
     sub->add_option("job", opt->job, "TOML job file (SPEC.md section 4)")->required();
     sub->add_option("-o,--output", opt->output, "result file (default: [run] output of the job)");

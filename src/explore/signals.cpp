@@ -3,13 +3,17 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <iterator>
 
 namespace superball {
 
 namespace {
 
 volatile std::sig_atomic_t received = 0;
-struct sigaction previous_int{}, previous_term{};
+// SIGUSR1/SIGUSR2 too: mpirun forwards those to every rank on every node, where it turns
+// a SIGTERM of its own into killing the ranks.
+constexpr int stop_signals[] = {SIGINT, SIGTERM, SIGUSR1, SIGUSR2};
+struct sigaction previous[std::size(stop_signals)]{};
 
 extern "C" void on_stop_signal(int sig)
 {
@@ -29,14 +33,12 @@ StopSignals::StopSignals()
     struct sigaction sa{};
     sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &previous_int);
-    sigaction(SIGTERM, &sa, &previous_term);
+    for (std::size_t i = 0; i < std::size(stop_signals); ++i) sigaction(stop_signals[i], &sa, &previous[i]);
 }
 
 StopSignals::~StopSignals()
 {
-    sigaction(SIGINT, &previous_int, nullptr);
-    sigaction(SIGTERM, &previous_term, nullptr);
+    for (std::size_t i = 0; i < std::size(stop_signals); ++i) sigaction(stop_signals[i], &previous[i], nullptr);
 }
 
 bool StopSignals::requested() { return received != 0; }

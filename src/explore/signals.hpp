@@ -1,4 +1,4 @@
-// SIGINT/SIGTERM handling for long runs: the first signal asks for a clean stop (no new
+// SIGINT/SIGTERM (and SIGUSR1/SIGUSR2) handling for long runs: the first signal asks for a clean stop (no new
 // tiles, tiles in flight finish, the file is closed consistent and resumable), a second
 // one ends the process at once (the file stays resumable: every tile marked done is on
 // disk).
@@ -15,7 +15,7 @@ public:
     StopSignals(const StopSignals&) = delete;
     StopSignals& operator=(const StopSignals&) = delete;
 
-    // True once SIGINT or SIGTERM arrived.
+    // True once SIGINT, SIGTERM, SIGUSR1 or SIGUSR2 arrived.
     static bool requested();
     // The signal that arrived (0 if none).
     static int which();
