@@ -1,7 +1,10 @@
+#include <fcntl.h>
 #include <fmt/core.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -77,8 +80,45 @@ Decision decide(const ExploreOptions& opt, const fs::path& out, const Job& job)
                                           "versions: use another --output, or --overwrite",
                                           out.string(), info.software_version, software_version)};
     }
+    // Never build on done tiles whose bytes changed on disk since they were written (nor
+    // call such a file complete).
+    try {
+        if (const std::vector<std::uint64_t> bad = damaged_tiles(out); !bad.empty()) {
+            return {Mode::refuse, fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
+                                              "checksum written with them; refusing to resume onto it: --overwrite to "
+                                              "start again, or --output to write elsewhere",
+                                              out.string(), bad.size(), info.tiles_done, bad.front())};
+        }
+    } catch (const std::exception& e) {
+        return {Mode::refuse, out.string() + " cannot be read back (" + e.what() +
+                                  "); refusing to resume onto it: --overwrite to start again, or --output to write elsewhere"};
+    }
     if (info.complete) return {Mode::complete, out.string() + " is already complete: nothing to do"};
     return {Mode::resume, fmt::format("resuming {}: {} of {} tiles already done", out.string(), info.tiles_done, info.tiles)};
+}
+
+// Rank 0, for a fresh run, before anything is written: the output's directory exists
+// (created if need be) and a file can be made there. A path that cannot be written is
+// refused like bad input (status 2, one message) instead of failing in the collective
+// HDF5 create on every rank (status 1 through MPI_Abort, and no reason given).
+Decision check_writable(const fs::path& out, Decision d)
+{
+    const auto refuse = [&](const std::string& why) {
+        return Decision{Mode::refuse, "cannot write the result " + out.string() + ": " + why +
+                                          "; choose another --output (or [run] output)"};
+    };
+    std::error_code ec;
+    if (out.has_parent_path()) {
+        fs::create_directories(out.parent_path(), ec);
+        if (ec) return refuse("cannot create its directory " + out.parent_path().string() + " (" + ec.message() + ")");
+    }
+    // Opened for writing without truncation (--overwrite replaces the file later, collectively).
+    const bool existed = fs::exists(out, ec);
+    const int fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) return refuse(std::error_code(errno, std::generic_category()).message());
+    ::close(fd);
+    if (!existed) fs::remove(out, ec);
+    return d;
 }
 
 // Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
@@ -165,7 +205,7 @@ int explore(const ExploreOptions& opt)
         Decision d;
         if (root) {
             d = decide(opt, out, job);
-            if (d.mode == Mode::fresh && out.has_parent_path()) fs::create_directories(out.parent_path());
+            if (d.mode == Mode::fresh) d = check_writable(out, std::move(d));
         }
         d.mode = static_cast<Mode>(world.broadcast(static_cast<std::int64_t>(d.mode)));
         world.broadcast(d.message);

@@ -4,6 +4,18 @@ namespace superball::h5 {
 
 void silence_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
+std::string error_detail()
+{
+    std::string innermost;
+    // Walking upward, entry 0 is the most specific one.
+    const auto first = [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
+        if (n == 0 && e->desc != nullptr) *static_cast<std::string*>(out) = e->desc;
+        return 0;
+    };
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, first, &innermost);
+    return innermost;
+}
+
 namespace {
 
 // Replaces an existing attribute: resume rewrites `complete` and `wall_seconds`.

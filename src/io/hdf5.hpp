@@ -17,11 +17,19 @@ struct Error : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Throws Error(what) when an HDF5 call reported failure (negative return).
+// The innermost message of HDF5's error stack for the last failed call (the stack is
+// silenced, not printed), e.g. "truncated file: eof = ..."; "" if there is none.
+std::string error_detail();
+
+// Throws Error(what) when an HDF5 call reported failure (negative return), with HDF5's
+// own reason in parentheses.
 template <class R>
 R check(R r, std::string_view what)
 {
-    if (r < 0) throw Error("HDF5: " + std::string(what) + " failed");
+    if (r < 0) {
+        const std::string detail = error_detail();
+        throw Error("HDF5: " + std::string(what) + " failed" + (detail.empty() ? "" : " (" + detail + ")"));
+    }
     return r;
 }
 
@@ -49,6 +57,10 @@ public:
     hid_t get() const { return id_; }
     operator hid_t() const { return id_; }  // NOLINT: passed straight to the C API
     bool valid() const { return id_ >= 0; }
+
+    // Gives the identifier up without closing it (ResultFile: a parallel file must not be
+    // closed by one rank alone).
+    hid_t release() { return std::exchange(id_, H5I_INVALID_HID); }
 
     // Closes now and reports failure (a destructor cannot).
     void close()

@@ -5,7 +5,9 @@
 // flushed before any tile is computed, so from then on the file's metadata never
 // changes until the end of the run. A tile's data is written (pwrite through MPI-IO)
 // before its byte in /progress/tile_done, so a process killed at any moment leaves a
-// readable file in which every tile marked done holds its final data.
+// readable file in which every tile marked done holds its final data. A checksum of the
+// tile's values, written between the two, lets a resume refuse a file whose done tiles
+// were changed on disk since (damaged_tiles).
 #pragma once
 
 #include <cstdint>
@@ -22,6 +24,12 @@
 #include "hdf5.hpp"
 
 namespace superball {
+
+// Tiles whose data no longer match the checksum written with them (/progress/
+// tile_checksum): bytes changed on disk after the tile was marked done. Read without MPI
+// (rank 0 before a resume). Empty when every done tile checks out, or for a file written
+// before checksums existed (nothing to compare).
+std::vector<std::uint64_t> damaged_tiles(const std::filesystem::path& path);
 
 // What a result file says about itself, read without MPI (rank 0 deciding whether to
 // resume, `superball info`).
@@ -56,11 +64,20 @@ public:
     // caller's business (read_result_info), done before.
     static ResultFile open(const std::filesystem::path& path, const mpi::Comm& comm);
 
+    // Closing is collective (H5Fclose of a parallel file). Destroyed by an exception on
+    // this rank alone, the file is not closed but let go: the caller ends every rank
+    // (MPI_Abort), and the file stays as the last tile left it, resumable. (Closing here
+    // waited for ranks that were still computing: a full disk hung the run.)
+    ~ResultFile();
+    ResultFile(ResultFile&&) noexcept = default;
+    ResultFile& operator=(ResultFile&&) noexcept = default;
+
     const Tiling& tiling() const { return tiling_; }
     // Done flags of all tiles (independent read; every rank may call it).
     std::vector<std::uint8_t> tiles_done() const;
 
-    // Independent: one tile's data, then its done flag.
+    // Independent: one tile's data, its checksum, then its done flag. A failed write
+    // throws h5::Error saying which tile and file, and how full the file system is.
     void write_tile(std::uint64_t tile, std::span<const std::uint32_t> wall_bounces,
                     std::span<const std::uint8_t> outcomes);
 
@@ -68,13 +85,15 @@ public:
     void finish(double run_seconds, int ranks, bool complete);
 
 private:
-    ResultFile(h5::Id file, Tiling tiling);
+    ResultFile(h5::Id file, Tiling tiling, std::filesystem::path path);
 
     h5::Id file_;
     h5::Id wall_bounces_;
     h5::Id outcome_;
     h5::Id tile_done_;
+    h5::Id tile_checksum_;  // not valid in files written before checksums existed
     Tiling tiling_;
+    std::filesystem::path path_;
     // uint16 counts are narrowed here, not by HDF5: its conversion path allocates and
     // zeroes a buffer on every write (measured 6% of a run).
     bool narrow_counts_ = false;

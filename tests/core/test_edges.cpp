@@ -307,7 +307,9 @@ TEST(Edges, PhysicalExtremesGiveAnOutcome)
              {1e-300, -1e300, 1e300, 0.0}, {1e300, -1e-300, 1e-300, 0.0}, {denorm, -1.0, 1.0, -1e300}, {0.02, -2.0, 2.0, -5.0}}) {
         const BounceCount r = count(s, model, 9.81, 1000);
         EXPECT_LT(static_cast<int>(r.outcome), outcome_count);
-        if (r.outcome == Outcome::invalid) EXPECT_EQ(r.wall_bounces, 0u);
+        if (r.outcome == Outcome::invalid) {
+            EXPECT_EQ(r.wall_bounces, 0u);
+        }
     }
 }
 
