@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "job.hpp"
+#include "spelling.hpp"
 
 namespace superball {
 namespace {
@@ -37,7 +38,7 @@ const std::vector<std::string> model_keys = {"e", "alpha", "e_wall", "alpha_wall
 const std::vector<std::string> range_keys = {"min", "max", "n"};
 const std::vector<std::string> run_keys = {"max_bounces", "output", "tile_points", "refine"};
 
-[[noreturn]] void fail(std::string message) { throw InputError(std::move(message)); }
+[[noreturn]] void fail(const std::string& message) { throw InputError(message); }
 
 std::vector<std::string> grid_keys(Coordinates c)
 {
@@ -110,41 +111,6 @@ std::string as_written(const toml::node& n)
 }
 
 // --- Unknown keys ------------------------------------------------------------------------
-
-char lower(char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); }
-
-// Levenshtein distance, ignoring case (so "w" is close to "W").
-std::size_t edit_distance(std::string_view a, std::string_view b)
-{
-    std::vector<std::size_t> row(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        std::size_t diagonal = row[0];
-        row[0] = i;
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const std::size_t substitution = diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1);
-            diagonal = row[j];
-            row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitution});
-        }
-    }
-    return row[b.size()];
-}
-
-// The known key closest to `key`, if close enough to be a plausible typo. A suggestion
-// must keep part of the candidate: "a" is not a misspelling of "U".
-std::optional<std::string> suggestion(std::string_view key, const std::vector<std::string>& known)
-{
-    std::optional<std::string> best;
-    std::size_t best_distance = 3;
-    for (const std::string& candidate : known) {
-        const std::size_t d = edit_distance(key, candidate);
-        if (d < best_distance && d < candidate.size()) {
-            best = candidate;
-            best_distance = d;
-        }
-    }
-    return best;
-}
 
 std::string unknown_key_message(std::string_view spelled, std::string_view key, const std::vector<std::string>& known,
                                 std::string_view (*spell_known)(std::string_view) = nullptr)

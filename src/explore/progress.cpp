@@ -3,13 +3,15 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <cmath>
+
 namespace superball {
 
 namespace {
 std::string duration_text(double s)
 {
     if (!(s < 1e9)) return "?";
-    const auto t = static_cast<long long>(s + 0.5);
+    const long long t = std::llround(s);  // s >= 0: a duration
     if (t >= 3600) return fmt::format("{}h{:02}m", t / 3600, (t % 3600) / 60);
     if (t >= 60) return fmt::format("{}m{:02}s", t / 60, t % 60);
     return fmt::format("{}s", t);

@@ -163,7 +163,7 @@ std::uint64_t refine_tile(const Extent& shape, std::uint32_t stride, const Count
         finer.clear();
         for (std::size_t j = 0; j < cells.size(); ++j) {
             const Cell& c = cells[j];
-            is_uniform[j] = uniform(c);
+            is_uniform[j] = static_cast<char>(uniform(c));
             if (is_uniform[j]) continue;
             lattice(d, c.a, c.b, half, [&](const Index& at) {
                 const std::uint64_t i = layout.index(at);

@@ -404,6 +404,32 @@ BAD_INPUT = [
     ("unknown flag (trajectory)", ["trajectory", *CANONICAL, *MODEL, "--frobnicate", "3"], "--frobnicate"),
     ("flag given twice", ["count", *CANONICAL, *MODEL, "--xi", "0.2"], "--xi"),
     ("no subcommand", [], "subcommand"),
+    # Typos get a suggestion; an unknown flag with none names the command's --help.
+    ("misspelt flag", ["count", *CANONICAL, *MODEL, "--max-bounce", "5"], "did you mean --max-bounces?"),
+    ("misspelt flag with =", ["trajectory", *CANONICAL, *MODEL, "--sampels=3"], "did you mean --samples?"),
+    ("unknown flag, no suggestion", ["count", *CANONICAL, *MODEL, "--verbose"], "see superball count --help"),
+    ("misspelt command", ["explor", "job.toml"], "did you mean explore?"),
+    ("unknown command", ["plot", "job.toml"], "commands: explore, count"),
+    # explore (the job file itself: tests/explore/test_job.cpp and test_explore.py)
+    ("explore without a job", ["explore"], "job"),
+    ("explore unknown kernel", ["explore", "job.toml", "--kernel", "avx"], "--kernel"),
+    ("explore misspelt flag", ["explore", "job.toml", "--kernl", "simd"], "did you mean --kernel?"),
+    ("explore resume and overwrite", ["explore", "job.toml", "--resume", "--overwrite"], "--resume"),
+    ("explore output without a value", ["explore", "job.toml", "-o"], "--output"),
+    ("explore missing job file", ["explore", "/nonexistent/job.toml"], "/nonexistent/job.toml"),
+    # info and analyse
+    ("info without a file", ["info"], "file"),
+    ("info of a missing file", ["info", "/nonexistent/r.h5"], "/nonexistent/r.h5"),
+    ("info of a file that is not a result", ["info", os.path.abspath(__file__)], "not a superball result"),
+    ("analyse of a missing file", ["analyse", "/nonexistent/r.h5"], "/nonexistent/r.h5"),
+    ("analyse box zero", ["analyse", "/nonexistent/r.h5", "--box", "0"], "--box"),
+    ("analyse box too large", ["analyse", "/nonexistent/r.h5", "--box", "5000"], "--box"),
+    ("analyse eps-max negative", ["analyse", "/nonexistent/r.h5", "--eps-max=-1"], "--eps-max"),
+    ("analyse box-max NaN", ["analyse", "/nonexistent/r.h5", "--box-max", "nan"], "--box-max"),
+    ("analyse top not a number", ["analyse", "/nonexistent/r.h5", "--top", "x"], "--top"),
+    # fixed-points (its ranges: tests/cli/test_fixed_points.py)
+    ("fixed-points misspelt flag", ["fixed-points", *MODEL, "--perod", "3"], "did you mean --period?"),
+    ("fixed-points seed not a number", ["fixed-points", *MODEL, "--seed", "abc"], "--seed"),
 ]
 
 

@@ -346,6 +346,13 @@ INSTANTIATE_TEST_SUITE_P(
                   {"[grid] has 9223372036854775807 x 4 x 9223372036854775807 = more than 2^64 points"}},
         ErrorCase{"RangeWidthOverflows", canonical_job("xi = { min = -1e308, max = 1e308, n = 8 }\n" + fixed_u_w),
                   {"[grid] xi", "min = -1e+308", "max = 1e+308", "overflows"}},
+        ErrorCase{"SamplesOverflow", canonical_job("xi = { min = 0, max = 1.7e308, n = 2 }\n" + fixed_u_w),
+                  {"[grid] xi", "n = 2", "the samples overflow"}},
+        ErrorCase{"BinaryGarbage", std::string("\x7f" "ELF\x02\x01\x01\0\0\xff\xfe[[", 13), {"jobs/test.toml:", "syntax error"}},
+        ErrorCase{"RefineNotPowerOfTwo", canonical_job(xi_range + fixed_u_w, "[run]\nrefine = 6\n"),
+                  {"[run] refine = 6 is out of range"}},
+        ErrorCase{"RefineString", canonical_job(xi_range + fixed_u_w, "[run]\nrefine = \"yes\"\n"),
+                  {"[run] refine = \"yes\"", "expected an integer"}},
         ErrorCase{"MisspelledCoordinatesString", canonical_job("coordinates = \"Physical\"\n" + xi_range + fixed_u_w),
                   {"[grid] coordinates = \"Physical\"", "did you mean \"physical\"?"}}),
     [](const testing::TestParamInfo<ErrorCase>& info) { return std::string(info.param.name); });

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string_view>
+#include <vector>
 
 #include "explore/job.hpp"
 
@@ -43,11 +44,24 @@ void check_invariants(const superball::Job& job)
                     "finite samples");
         }
     }
-    require(ranges >= 1 && ranges <= 3, "1 to 3 ranges");
+    require(ranges <= 3, "at most 3 coordinate ranges");
+    // Swept coefficients: ranges too, and the model is valid at both ends of each.
+    std::vector<double> first, last;
+    for (const superball::Coordinate& p : job.parameters) {
+        require(p.range.has_value() && !p.fixed.has_value(), "a swept coefficient is a range");
+        require(std::isfinite(p.range->min) && std::isfinite(p.range->max) && p.range->min < p.range->max,
+                "finite swept range, min < max");
+        require(p.range->n >= 1, "n >= 1");
+        first.push_back(p.range->sample(0));
+        last.push_back(p.range->sample(p.range->n - 1));
+    }
+    for (const int index : job.swept) require(index >= -1 && index < static_cast<int>(job.parameters.size()), "swept index");
+    const std::size_t axes = job.range_axes().size();
+    require(axes >= 1 && axes <= 4, "1 to 4 range axes");
     require(job.points() >= 1 && job.points() <= (std::uint64_t{1} << 40), "1 <= points <= 2^40");
     require(job.max_bounces >= 1, "max_bounces >= 1");
-    for (const superball::Surface& s : {job.model.wall, job.model.floor}) {
-        require(superball::in_range(s), "coefficients in range");
+    for (const superball::Model& m : {job.model, job.model_at(first), job.model_at(last)}) {
+        require(superball::in_range(m), "coefficients in range");
     }
     if (job.coordinates == Coordinates::physical) {
         require(job.frame.g > 0 && std::isfinite(job.frame.g), "g > 0");

@@ -39,6 +39,9 @@ from superball_testing import descendants, mpi_env, superball_binary  # noqa: E4
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
+# The jobs' max_bounces are set from the speed of the binary under test (calibrate()), so
+# that the runs last the same few seconds in a release build and under AddressSanitizer.
+
 # No dissipation: one point in eight bounces to the cap, so the run lasts seconds, in
 # tiles of a fraction of a second (a clean stop is quick).
 MEDIUM_JOB = """[model]
@@ -51,12 +54,13 @@ U = -1.0
 W = { min = -3.0, max = 3.0, n = 300 }
 
 [run]
-max_bounces = 20000
+max_bounces = {max_bounces}
 tile_points = 400
 """
+MEDIUM_SECONDS = 4.0  # on two ranks
 
 # Around the marginally stable self-retracing motion (0.25, -0.5, -1.25): every point is
-# capped, so each of the 8 tiles takes about a second (three under AddressSanitizer).
+# capped, so each of the 8 tiles takes about a second.
 LONG_TILES_JOB = """[model]
 e = 1.0
 alpha = 1.0
@@ -67,9 +71,10 @@ U = -0.5
 W = { min = -1.27, max = -1.23, n = 40 }
 
 [run]
-max_bounces = 1000000
+max_bounces = {max_bounces}
 tile_points = 100
 """
+TILE_SECONDS = 1.0
 
 
 def rank_of(pid):
@@ -110,6 +115,28 @@ class Signals(unittest.TestCase):
         cls.binary = superball_binary()
         cls.dir = tempfile.mkdtemp(prefix="superball-signals-")
         cls.references = {}
+        speed = cls.calibrate()
+        print(f"calibrated: {speed:.3g} wall impacts per second", file=sys.stderr)
+        # MEDIUM: about 11000 of its 90000 points are capped; LONG: 100 capped points a tile.
+        cls.jobs = {"medium": MEDIUM_JOB.replace("{max_bounces}", str(max(100, int(2 * MEDIUM_SECONDS * speed / 11000)))),
+                    "long": LONG_TILES_JOB.replace("{max_bounces}", str(max(1000, int(TILE_SECONDS * speed / 100))))}
+
+    @classmethod
+    def calibrate(cls):
+        """Wall impacts per second of one rank, from the summary of a run in which every
+        point is capped (raising max_bounces until it takes a quarter of a second)."""
+        job, out = os.path.join(cls.dir, "calibrate.toml"), os.path.join(cls.dir, "calibrate.h5")
+        max_bounces = 100000
+        while True:
+            with open(job, "w") as f:
+                f.write(LONG_TILES_JOB.replace("{max_bounces}", str(max_bounces)).replace("n = 20", "n = 2").replace("n = 40", "n = 2"))
+            r = subprocess.run([cls.binary, "explore", job, "-o", out, "--overwrite"], capture_output=True, text=True,
+                               env=mpi_env(), timeout=300)
+            assert r.returncode == 0, r.stderr
+            seconds = float(r.stderr.split("done: 4 points computed in ")[1].split()[0])
+            if seconds >= 0.25 or max_bounces >= 10**9:
+                return 4 * max_bounces / max(seconds, 0.01)
+            max_bounces *= 4
 
     @classmethod
     def tearDownClass(cls):
@@ -118,12 +145,12 @@ class Signals(unittest.TestCase):
     def path(self, name):
         return os.path.join(self.dir, name)
 
-    def job(self, text):
-        name = "medium.toml" if text is MEDIUM_JOB else "long.toml"
-        if not os.path.exists(self.path(name)):
-            with open(self.path(name), "w") as f:
-                f.write(text)
-        return self.path(name)
+    def job(self, name):
+        path = self.path(name + ".toml")
+        if not os.path.exists(path):
+            with open(path, "w") as f:
+                f.write(self.jobs[name])
+        return path
 
     def explore(self, job, output, *extra, expect=0):
         cmd = [MPIEXEC, "-n", "2", "--oversubscribe", self.binary, "explore", job, "-o", output, "-q", *extra]
@@ -214,7 +241,7 @@ class Signals(unittest.TestCase):
             np.testing.assert_array_equal(f["outcome"][()], oc_ref)
 
     def test_a_sigterm_to_every_rank(self):
-        job, out = self.job(MEDIUM_JOB), self.path("a.h5")
+        job, out = self.job("medium"), self.path("a.h5")
         self.reference(job)
         proc = self.start(job, out)
         ranks = self.ranks(proc)
@@ -229,7 +256,7 @@ class Signals(unittest.TestCase):
         self.assert_consistent_and_resumable(job, out)
 
     def test_b_sigint_to_rank_0_only(self):
-        job, out = self.job(MEDIUM_JOB), self.path("b.h5")
+        job, out = self.job("medium"), self.path("b.h5")
         self.reference(job)
         proc = self.start(job, out)
         ranks = self.ranks(proc)
@@ -242,7 +269,7 @@ class Signals(unittest.TestCase):
         self.assert_consistent_and_resumable(job, out)
 
     def test_c_second_signal_stops_at_once(self):
-        job, out = self.job(LONG_TILES_JOB), self.path("c.h5")
+        job, out = self.job("long"), self.path("c.h5")
         self.reference(job)
         proc = self.start(job, out)
         ranks = self.ranks(proc)
@@ -260,7 +287,7 @@ class Signals(unittest.TestCase):
         self.assert_consistent_and_resumable(job, out)
 
     def test_d_sigkill_of_a_worker(self):
-        job, out = self.job(MEDIUM_JOB), self.path("d.h5")
+        job, out = self.job("medium"), self.path("d.h5")
         self.reference(job)
         proc = self.start(job, out)
         ranks = self.ranks(proc)
@@ -272,7 +299,7 @@ class Signals(unittest.TestCase):
 
     def test_e_sigterm_to_mpirun(self):
         # Long tiles: more work left than Open MPI's two-second grace can finish.
-        job, out = self.job(LONG_TILES_JOB), self.path("e.h5")
+        job, out = self.job("long"), self.path("e.h5")
         self.reference(job)
         proc = self.start(job, out)
         ranks = self.ranks(proc)
