@@ -1,6 +1,7 @@
 """Helpers shared by the Python end-to-end tests: where the binary is, the environment
-mpirun needs, and the processes below mpirun."""
+mpirun needs, the processes below mpirun, and how fast the binary under test is."""
 import os
+import subprocess
 import unittest
 
 SOURCE = os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -44,3 +45,38 @@ def descendants(pid):
             found.append(child)
             todo.append(child)
     return found
+
+
+# Every point capped: around the marginally stable self-retracing motion (0.25, -0.5,
+# -1.25) of the dissipation-free model.
+_CALIBRATION_JOB = """[model]
+e = 1.0
+alpha = 1.0
+
+[grid]
+xi = { min = 0.24, max = 0.26, n = 2 }
+U = -0.5
+W = { min = -1.27, max = -1.23, n = 2 }
+
+[run]
+max_bounces = %d
+"""
+
+
+def wall_impacts_per_second(binary, directory):
+    """Wall impacts per second of one rank of `binary`, from the summary of a run in which
+    every point is capped (max_bounces raised until it takes a quarter of a second). Tests
+    that must stop a run part-way size their jobs with it, so that the runs last the same
+    few seconds in a release build and under AddressSanitizer."""
+    job, out = os.path.join(directory, "calibrate.toml"), os.path.join(directory, "calibrate.h5")
+    max_bounces = 100000
+    while True:
+        with open(job, "w") as f:
+            f.write(_CALIBRATION_JOB % max_bounces)
+        r = subprocess.run([binary, "explore", job, "-o", out, "--overwrite"], capture_output=True, text=True,
+                           env=mpi_env(), timeout=300)
+        assert r.returncode == 0, r.stderr
+        seconds = float(r.stderr.split("done: 4 points computed in ")[1].split()[0])
+        if seconds >= 0.25 or max_bounces >= 10**9:
+            return 4 * max_bounces / max(seconds, 0.01)
+        max_bounces *= 4

@@ -35,12 +35,12 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import descendants, mpi_env, superball_binary  # noqa: E402
+from superball_testing import descendants, mpi_env, superball_binary, wall_impacts_per_second  # noqa: E402
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
-# The jobs' max_bounces are set from the speed of the binary under test (calibrate()), so
-# that the runs last the same few seconds in a release build and under AddressSanitizer.
+# The jobs' max_bounces are set from the speed of the binary under test
+# (wall_impacts_per_second), so that the runs last the same few seconds in a release build and under AddressSanitizer.
 
 # No dissipation: one point in eight bounces to the cap, so the run lasts seconds, in
 # tiles of a fraction of a second (a clean stop is quick).
@@ -115,28 +115,11 @@ class Signals(unittest.TestCase):
         cls.binary = superball_binary()
         cls.dir = tempfile.mkdtemp(prefix="superball-signals-")
         cls.references = {}
-        speed = cls.calibrate()
+        speed = wall_impacts_per_second(cls.binary, cls.dir)
         print(f"calibrated: {speed:.3g} wall impacts per second", file=sys.stderr)
         # MEDIUM: about 11000 of its 90000 points are capped; LONG: 100 capped points a tile.
         cls.jobs = {"medium": MEDIUM_JOB.replace("{max_bounces}", str(max(100, int(2 * MEDIUM_SECONDS * speed / 11000)))),
                     "long": LONG_TILES_JOB.replace("{max_bounces}", str(max(1000, int(TILE_SECONDS * speed / 100))))}
-
-    @classmethod
-    def calibrate(cls):
-        """Wall impacts per second of one rank, from the summary of a run in which every
-        point is capped (raising max_bounces until it takes a quarter of a second)."""
-        job, out = os.path.join(cls.dir, "calibrate.toml"), os.path.join(cls.dir, "calibrate.h5")
-        max_bounces = 100000
-        while True:
-            with open(job, "w") as f:
-                f.write(LONG_TILES_JOB.replace("{max_bounces}", str(max_bounces)).replace("n = 20", "n = 2").replace("n = 40", "n = 2"))
-            r = subprocess.run([cls.binary, "explore", job, "-o", out, "--overwrite"], capture_output=True, text=True,
-                               env=mpi_env(), timeout=300)
-            assert r.returncode == 0, r.stderr
-            seconds = float(r.stderr.split("done: 4 points computed in ")[1].split()[0])
-            if seconds >= 0.25 or max_bounces >= 10**9:
-                return 4 * max_bounces / max(seconds, 0.01)
-            max_bounces *= 4
 
     @classmethod
     def tearDownClass(cls):
