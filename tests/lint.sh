@@ -4,7 +4,7 @@
 # out says why), with the compile_commands.json of build/release (configured if missing;
 # SUPERBALL_BUILD_DIR picks another build). Exits non-zero on any finding.
 #
-#   tests/lint.sh            cppcheck (seconds) and clang-tidy (about 3 minutes on 2 cores)
+#   tests/lint.sh            cppcheck (seconds) and clang-tidy (about 4 minutes on 2 cores)
 #   tests/lint.sh --quick    cppcheck only (what tests/run runs)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
