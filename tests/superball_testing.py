@@ -47,20 +47,24 @@ def descendants(pid):
     return found
 
 
-# Every point capped: around the marginally stable self-retracing motion (0.25, -0.5,
-# -1.25) of the dissipation-free model.
-_CALIBRATION_JOB = """[model]
-e = 1.0
-alpha = 1.0
+def capped_job(max_bounces, n_xi=2, n_W=2, tile_points=None):
+    """A job in which every point bounces to the cap: around the marginally stable
+    self-retracing motion (0.25, -0.5, -1.25) of the dissipation-free model."""
+    run = f"max_bounces = {max_bounces}" + (f"\ntile_points = {tile_points}" if tile_points else "")
+    return ("[model]\ne = 1.0\nalpha = 1.0\n\n[grid]\n"
+            f"xi = {{ min = 0.24, max = 0.26, n = {n_xi} }}\nU = -0.5\nW = {{ min = -1.27, max = -1.23, n = {n_W} }}\n\n"
+            f"[run]\n{run}\n")
 
-[grid]
-xi = { min = 0.24, max = 0.26, n = 2 }
-U = -0.5
-W = { min = -1.27, max = -1.23, n = 2 }
 
-[run]
-max_bounces = %d
-"""
+def killable_job(speed, seconds):
+    """No dissipation over the (xi, W) slice at U = -1: about 11000 of its 300^2 points
+    bounce to the cap, max_bounces set from `speed` (wall_impacts_per_second) so that two
+    ranks take about `seconds`, in tiles of 400 points that each take a fraction of a
+    second (a clean stop is quick)."""
+    max_bounces = max(100, int(2 * seconds * speed / 11000))
+    return ("[model]\ne = 1.0\nalpha = 1.0\n\n[grid]\n"
+            "xi = { min = 0.0, max = 1.0, n = 300 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 300 }\n\n"
+            f"[run]\nmax_bounces = {max_bounces}\ntile_points = 400\n")
 
 
 def wall_impacts_per_second(binary, directory):
@@ -72,7 +76,7 @@ def wall_impacts_per_second(binary, directory):
     max_bounces = 100000
     while True:
         with open(job, "w") as f:
-            f.write(_CALIBRATION_JOB % max_bounces)
+            f.write(capped_job(max_bounces))
         r = subprocess.run([binary, "explore", job, "-o", out, "--overwrite"], capture_output=True, text=True,
                            env=mpi_env(), timeout=300)
         assert r.returncode == 0, r.stderr

@@ -55,24 +55,33 @@ BounceCount count_on_plane(const CanonicalState<double>& start, const ModelMatri
     return iterate(c, 1, m, max_bounces);
 }
 
-void count_each_on_plane(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
-                         std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
+namespace {
+
+// Writes `one(start)` of every start into the two output arrays.
+template <class Count>
+void count_into(const StartsView& starts, Count one, std::span<std::uint32_t> wall_bounces,
+                std::span<std::uint8_t> outcomes)
 {
     for (std::size_t i = 0; i < starts.size(); ++i) {
-        const BounceCount r = count_on_plane(starts[i], m, max_bounces);
+        const BounceCount r = one(starts[i]);
         wall_bounces[i] = r.wall_bounces;
         outcomes[i] = static_cast<std::uint8_t>(r.outcome);
     }
 }
 
+}  // namespace
+
+void count_each_on_plane(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
+                         std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
+{
+    count_into(starts, [&](const CanonicalState<double>& s) { return count_on_plane(s, m, max_bounces); }, wall_bounces,
+               outcomes);
+}
+
 void count_each(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                 std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
 {
-    for (std::size_t i = 0; i < starts.size(); ++i) {
-        const BounceCount r = count(starts[i], m, max_bounces);
-        wall_bounces[i] = r.wall_bounces;
-        outcomes[i] = static_cast<std::uint8_t>(r.outcome);
-    }
+    count_into(starts, [&](const CanonicalState<double>& s) { return count(s, m, max_bounces); }, wall_bounces, outcomes);
 }
 
 BounceCount count(const PhysicalState<double>& start, const Model& m, double g, std::uint32_t max_bounces)

@@ -18,7 +18,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import mpi_env, descendants, wall_impacts_per_second  # noqa: E402
+from superball_testing import descendants, killable_job, mpi_env, wall_impacts_per_second  # noqa: E402
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
@@ -288,13 +288,9 @@ class Explore(unittest.TestCase):
 
     def test_resume_after_sigkill(self):
         """A run killed with SIGKILL mid-way, then --resume, equals an uninterrupted run."""
-        # Conservative model: about 11000 of the 90000 points bounce to the cap, set so
-        # that the run lasts about 2.5 s on two ranks of the binary under test (a release
-        # build or a sanitized one), long enough to be killed part-way.
-        max_bounces = max(100, int(2 * 2.5 * wall_impacts_per_second(SUPERBALL, self.dir) / 11000))
-        grid = 'xi = { min = 0.0, max = 1.0, n = 300 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 300 }'
-        job = self.write_job(job_text(grid, model="e = 1.0\nalpha = 1.0",
-                                      run=f"max_bounces = {max_bounces}\ntile_points = 400"))
+        # Sized by the speed of the binary under test (a release build or a sanitized
+        # one) to last about 2.5 s on two ranks, long enough to be killed part-way.
+        job = self.write_job(killable_job(wall_impacts_per_second(SUPERBALL, self.dir), 2.5))
         out = self.path("killed.h5")
         proc = subprocess.Popen([MPIEXEC, "-n", "2", "--oversubscribe", SUPERBALL, "explore", job, "-o", out, "-q"],
                                 env=mpi_env(), start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)

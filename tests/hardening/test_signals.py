@@ -35,45 +35,15 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import descendants, mpi_env, superball_binary, wall_impacts_per_second  # noqa: E402
+from superball_testing import capped_job, descendants, killable_job, mpi_env, superball_binary, wall_impacts_per_second  # noqa: E402
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
 # The jobs' max_bounces are set from the speed of the binary under test
-# (wall_impacts_per_second), so that the runs last the same few seconds in a release build and under AddressSanitizer.
-
-# No dissipation: one point in eight bounces to the cap, so the run lasts seconds, in
-# tiles of a fraction of a second (a clean stop is quick).
-MEDIUM_JOB = """[model]
-e = 1.0
-alpha = 1.0
-
-[grid]
-xi = { min = 0.0, max = 1.0, n = 300 }
-U = -1.0
-W = { min = -3.0, max = 3.0, n = 300 }
-
-[run]
-max_bounces = {max_bounces}
-tile_points = 400
-"""
-MEDIUM_SECONDS = 4.0  # on two ranks
-
-# Around the marginally stable self-retracing motion (0.25, -0.5, -1.25): every point is
-# capped, so each of the 8 tiles takes about a second.
-LONG_TILES_JOB = """[model]
-e = 1.0
-alpha = 1.0
-
-[grid]
-xi = { min = 0.24, max = 0.26, n = 20 }
-U = -0.5
-W = { min = -1.27, max = -1.23, n = 40 }
-
-[run]
-max_bounces = {max_bounces}
-tile_points = 100
-"""
+# (wall_impacts_per_second), so that the runs last the same few seconds in a release build
+# and under AddressSanitizer: MEDIUM (killable_job) about 4 s on two ranks; LONG
+# (capped_job, 8 tiles of 100 capped points) about a second a tile.
+MEDIUM_SECONDS = 4.0
 TILE_SECONDS = 1.0
 
 
@@ -118,8 +88,8 @@ class Signals(unittest.TestCase):
         speed = wall_impacts_per_second(cls.binary, cls.dir)
         print(f"calibrated: {speed:.3g} wall impacts per second", file=sys.stderr)
         # MEDIUM: about 11000 of its 90000 points are capped; LONG: 100 capped points a tile.
-        cls.jobs = {"medium": MEDIUM_JOB.replace("{max_bounces}", str(max(100, int(2 * MEDIUM_SECONDS * speed / 11000)))),
-                    "long": LONG_TILES_JOB.replace("{max_bounces}", str(max(1000, int(TILE_SECONDS * speed / 100))))}
+        cls.jobs = {"medium": killable_job(speed, MEDIUM_SECONDS),
+                    "long": capped_job(max(1000, int(TILE_SECONDS * speed / 100)), n_xi=20, n_W=40, tile_points=100)}
 
     @classmethod
     def tearDownClass(cls):
