@@ -11,7 +11,7 @@
 #include "core/count.hpp"
 #include "core/input.hpp"
 #include "io/hdf5.hpp"
-#include "io/structure.hpp"
+#include "io/result_plane.hpp"
 
 namespace superball::cli {
 

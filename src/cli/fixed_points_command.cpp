@@ -10,7 +10,8 @@
 
 #include "commands.hpp"
 #include "core/dynamics.hpp"
-#include "explore/mpi.hpp"
+#include "mpi/mpi.hpp"
+#include "run/cycles.hpp"
 #include "options.hpp"
 
 namespace superball::cli {
@@ -38,79 +39,6 @@ void validate(const FixedPointOptions& opt)
     if (opt.format != "table" && opt.format != "json") {
         throw InputError("--format = " + opt.format + " is not a format: accepted table or json");
     }
-}
-
-// Newton's method converged from start `start` for G^`k` at `point`.
-struct Hit {
-    std::uint64_t start;
-    int k;
-    Domain domain;
-    CanonicalState<double> point;
-};
-
-constexpr int hit_doubles = 6;
-
-// This rank's share of the starts: every rank draws the whole sequence (cheap next to
-// Newton's method) and keeps the indices i = rank mod size, so the starts, and the order
-// in which rank 0 examines what they found, are those of a serial run.
-std::vector<double> search(const ModelMatrices& m, const FixedPointOptions& opt, int rank, int size)
-{
-    std::vector<double> hits;
-    SeededStarts draw(opt.seed);
-    for (std::int64_t i = 0; i < opt.starts; ++i) {
-        const CanonicalState<double> start = draw.next();
-        if (i % size != rank) continue;
-        for (int k = 1; k <= opt.period; ++k) {
-            for (const Domain domain : {Domain::interior, Domain::corner}) {
-                if (domain == Domain::corner && !opt.corner) continue;
-                if (const auto p = newton_cycle(start, m, k, domain)) {
-                    hits.insert(hits.end(), {static_cast<double>(i), static_cast<double>(k),
-                                             static_cast<double>(domain), p->xi, p->U, p->W});
-                }
-            }
-        }
-    }
-    return hits;
-}
-
-// Every rank's hits on rank 0 (empty elsewhere).
-std::vector<double> gather(const mpi::Comm& comm, const std::vector<double>& mine)
-{
-    const int size = comm.size();
-    const int n = static_cast<int>(mine.size());
-    std::vector<int> counts(comm.is_root() ? static_cast<std::size_t>(size) : 0);
-    mpi::check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm.get()), "MPI_Gather");
-    std::vector<int> offsets(counts.size());
-    std::vector<double> all;
-    if (comm.is_root()) {
-        int total = 0;
-        for (std::size_t r = 0; r < counts.size(); ++r) {
-            offsets[r] = total;
-            total += counts[r];
-        }
-        all.resize(static_cast<std::size_t>(total));
-    }
-    mpi::check(MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0,
-                           comm.get()),
-               "MPI_Gatherv");
-    return all;
-}
-
-std::vector<Hit> unpack(const std::vector<double>& data)
-{
-    std::vector<Hit> hits;
-    for (std::size_t i = 0; i + hit_doubles <= data.size(); i += hit_doubles) {
-        hits.push_back({static_cast<std::uint64_t>(data[i]), static_cast<int>(data[i + 1]),
-                        static_cast<Domain>(static_cast<int>(data[i + 2])), {data[i + 3], data[i + 4], data[i + 5]}});
-    }
-    // Serial order: by start, then period, then domain. distinct_cycles keeps the first of
-    // repeated cycles, so the output does not depend on the number of ranks.
-    std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) {
-        if (a.start != b.start) return a.start < b.start;
-        if (a.k != b.k) return a.k < b.k;
-        return a.domain < b.domain;
-    });
-    return hits;
 }
 
 std::string eigenvalue_text(const std::complex<double>& z)
@@ -185,22 +113,15 @@ int run(const FixedPointOptions& opt)
         if (world.is_root()) fmt::print(stderr, "superball fixed-points: {}\n", e.what());
         return 2;
     }
-    const ModelMatrices m = ModelMatrices::of(model);
-    std::vector<double> all;
+    std::vector<Cycle> cycles;
     try {
-        all = gather(world, search(m, opt, world.rank(), world.size()));
+        cycles = find_cycles(model, {opt.period, opt.starts, opt.seed, opt.corner}, world);
     } catch (const std::exception& e) {
         // The other ranks would wait in the gather for ever: end them all.
         fmt::print(stderr, "superball fixed-points (rank {}): error: {}\n", world.rank(), e.what());
         world.abort(1);
     }
     if (!world.is_root()) return 0;
-
-    std::vector<Cycle> found;
-    for (const Hit& h : unpack(all)) {
-        if (auto c = make_cycle(h.point, m, h.k, h.domain)) found.push_back(std::move(*c));
-    }
-    const std::vector<Cycle> cycles = distinct_cycles(found);
 
     std::FILE* f = stdout;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);

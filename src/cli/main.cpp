@@ -15,7 +15,7 @@
 
 #include "commands.hpp"
 #include "core/input.hpp"
-#include "explore/spelling.hpp"
+#include "job/spelling.hpp"
 #include "superball/version.hpp"
 
 namespace {

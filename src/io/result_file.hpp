@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "explore/grid.hpp"
-#include "explore/job.hpp"
-#include "explore/mpi.hpp"
-#include "explore/tiles.hpp"
+#include "job/grid.hpp"
+#include "job/job.hpp"
+#include "mpi/mpi.hpp"
+#include "job/tiles.hpp"
 #include "hdf5.hpp"
 
 namespace superball {

@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "explore/job.hpp"
+#include "job/job.hpp"
 
 namespace {
 

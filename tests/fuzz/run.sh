@@ -17,7 +17,7 @@ command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found: run .ci/install-de
 
 # What parse_job needs: the job layer and the model input checks. toml++ is compiled
 # header-only so that the TOML parser is instrumented and fuzzed too.
-sources=(tests/fuzz/fuzz_job.cpp src/explore/job.cpp src/explore/job_parse.cpp src/explore/spelling.cpp src/core/input.cpp)
+sources=(tests/fuzz/fuzz_job.cpp src/job/job.cpp src/job/job_parse.cpp src/job/spelling.cpp src/core/input.cpp)
 # toml_assert.hpp: see there (toml++ 3.3.0 preconditions on the current character are
 # passed over, as in release). -fno-sanitize=unreachable: toml++ 3.3.0's
 # is_non_ascii_horizontal_whitespace() reaches TOML_UNREACHABLE for some non-ASCII
@@ -29,7 +29,7 @@ flags=(-std=c++20 -g -O1 -fno-omit-frame-pointer -ffp-contract=off -DTOML_HEADER
        -include "$root/tests/fuzz/toml_assert.hpp"
        -fsanitize=fuzzer,address,undefined -fno-sanitize=unreachable -fno-sanitize-recover=all)
 stamp=$out/fuzz_job.stamp
-if [[ ! -x $out/fuzz_job ]] || [[ -n $(cd "$root" && find "${sources[@]}" src/explore/job.hpp src/explore/spelling.hpp src/core/input.hpp \
+if [[ ! -x $out/fuzz_job ]] || [[ -n $(cd "$root" && find "${sources[@]}" src/job/job.hpp src/job/spelling.hpp src/core/input.hpp \
       src/core/model.hpp src/core/state.hpp tests/fuzz/toml_assert.hpp tests/fuzz/run.sh -newer "$stamp" 2>/dev/null) ]]; then
   echo "fuzz: building $out/fuzz_job" >&2
   (cd "$root" && "$cxx" "${flags[@]}" "${sources[@]}" -o "$out/fuzz_job.tmp")

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/count.hpp"
-#include "grid.hpp"
-#include "schedule.hpp"
+#include "job/grid.hpp"
+#include "run/schedule.hpp"
 
 namespace superball {
 

@@ -1,6 +1,6 @@
 // The structure estimators of `superball analyse` on fields with known answers, and
 // against direct (whole-array) computations of the same definitions.
-#include "io/structure.hpp"
+#include "measures/structure.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "explore/job.hpp"
+#include "job/job.hpp"
 
 namespace superball {
 namespace {

@@ -10,7 +10,7 @@
 #include <functional>
 #include <span>
 
-#include "tiles.hpp"
+#include "job/tiles.hpp"
 
 namespace superball {
 

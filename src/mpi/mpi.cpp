@@ -73,6 +73,26 @@ double Comm::max(double x) const
     return out;
 }
 
+std::vector<double> Comm::gather(const std::vector<double>& mine) const
+{
+    const int n = static_cast<int>(mine.size());
+    std::vector<int> counts(is_root() ? static_cast<std::size_t>(size()) : 0);
+    check(MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_), "MPI_Gather");
+    std::vector<int> offsets(counts.size());
+    std::vector<double> all;
+    if (is_root()) {
+        int total = 0;
+        for (std::size_t r = 0; r < counts.size(); ++r) {
+            offsets[r] = total;
+            total += counts[r];
+        }
+        all.resize(static_cast<std::size_t>(total));
+    }
+    check(MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0, comm_),
+          "MPI_Gatherv");
+    return all;
+}
+
 double Comm::broadcast(double x) const
 {
     check(MPI_Bcast(&x, 1, MPI_DOUBLE, 0, comm_), "MPI_Bcast");

@@ -10,7 +10,7 @@
 #include <deque>
 #include <functional>
 
-#include "mpi.hpp"
+#include "mpi/mpi.hpp"
 
 namespace superball {
 

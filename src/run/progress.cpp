@@ -18,26 +18,31 @@ std::string duration_text(double s)
 }
 }  // namespace
 
-Progress::Progress(std::FILE* out, bool quiet, std::uint64_t total_tiles, std::uint64_t total_points, std::uint64_t already_tiles,
-                   std::uint64_t already_points)
-    : out_(out),
-      quiet_(quiet),
-      live_(isatty(fileno(out)) != 0),
-      total_tiles_(total_tiles),
-      total_points_(total_points),
-      tiles_done_(already_tiles),
-      points_done_(already_points)
+TerminalProgress::TerminalProgress(std::FILE* out, bool quiet) : out_(out), quiet_(quiet), live_(isatty(fileno(out)) != 0) {}
+
+void TerminalProgress::started(const RunStart& s)
 {
+    total_tiles_ = s.tiles;
+    total_points_ = s.grid_points;
+    tiles_done_ = s.tiles_done;
+    points_done_ = s.points_done;
+    start_ = last_report_ = Clock::now();
+    if (quiet_) return;
+    if (!s.note.empty()) fmt::print(out_, "{}\n", s.note);
+    if (s.tiles == 0) return;  // nothing to compute
+    fmt::print(out_, "superball explore: {} points ({} tiles of up to {} points) on {} rank{}\n", s.grid_points, s.tiles,
+               s.tile_points, s.ranks, s.ranks == 1 ? "" : "s");
+    std::fflush(out_);
 }
 
-double Progress::seconds() const
+double TerminalProgress::seconds() const
 {
-    return std::chrono::duration<double>((stopped_ ? stop_ : Clock::now()) - start_).count();
+    return final_seconds_ >= 0 ? final_seconds_ : std::chrono::duration<double>(Clock::now() - start_).count();
 }
 
-void Progress::tile_done(std::uint64_t points)
+void TerminalProgress::tiles_done(std::uint64_t tiles, std::uint64_t points)
 {
-    ++tiles_done_;
+    tiles_done_ += tiles;
     points_done_ += points;
     points_run_ += points;
     if (quiet_) return;
@@ -50,7 +55,7 @@ void Progress::tile_done(std::uint64_t points)
     }
 }
 
-void Progress::report(bool final)
+void TerminalProgress::report(bool final)
 {
     const double s = seconds();
     const double rate = s > 0 ? static_cast<double>(points_run_) / s : 0.0;
@@ -67,11 +72,10 @@ void Progress::report(bool final)
     std::fflush(out_);
 }
 
-void Progress::finish()
+void TerminalProgress::computed(double seconds)
 {
-    stop_ = Clock::now();
-    stopped_ = true;
-    if (!quiet_) report(true);
+    final_seconds_ = seconds;
+    if (!quiet_ && total_tiles_ > 0) report(true);
 }
 
 }  // namespace superball

@@ -1,4 +1,5 @@
-// Small RAII layer over the MPI calls the explorer uses.
+// Small RAII layer over the MPI calls superball makes: the environment, communicators and
+// the few collectives the runs need. No other project code: io/ and run/ build on it.
 #pragma once
 
 #include <mpi.h>
@@ -44,6 +45,8 @@ public:
     std::vector<std::uint64_t> sum(const std::vector<std::uint64_t>& v) const;
     // Largest value over ranks, on every rank.
     double max(double x) const;
+    // Every rank's values concatenated in rank order, on rank 0 (empty elsewhere).
+    std::vector<double> gather(const std::vector<double>& mine) const;
 
     // Ends every process of the job: the only way out when one rank fails outside a
     // collective operation.

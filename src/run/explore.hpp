@@ -1,0 +1,74 @@
+// Running an exploration job on a communicator: the library function behind
+// `superball explore`, for the command line, C++ tests and other front ends.
+//
+//   plan:   rank 0 decides what to do with the output (a new run, a resume, nothing to
+//           do, or a refusal naming why), the others are told; the grid is cut into tiles.
+//   run:    tiles are scheduled over the ranks, counted, written and recorded done.
+//   finish: the result is closed consistent, complete or resumable.
+//
+// Progress goes to a RunObserver (rank 0 only); a stop is asked for through a predicate
+// polled on every rank (StopSignals::requested for the command line).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "job/job.hpp"
+#include "job/tiles.hpp"
+#include "mpi/mpi.hpp"
+#include "run/progress.hpp"
+#include "run/schedule.hpp"
+
+namespace superball {
+
+enum class KernelChoice { simd, scalar };
+
+struct ExploreSettings {
+    std::filesystem::path output;  // the result file; empty: the job's [run] output
+    bool resume = false;           // finish an interrupted run of the same job
+    bool overwrite = false;        // replace an existing result
+    KernelChoice kernel = KernelChoice::simd;
+};
+
+// The output path a job and settings write to: settings.output, else the job's [run]
+// output; InputError if neither is given.
+std::filesystem::path output_path(const Job& job, const ExploreSettings& settings);
+
+enum class PlanMode : std::int64_t { fresh, resume, complete };
+
+// What a run will do, the same on every rank.
+struct ExplorePlan {
+    PlanMode mode = PlanMode::fresh;
+    std::filesystem::path output;
+    std::string note;  // for the user: what was decided and why (may be empty)
+};
+
+// Collective. Throws InputError (on every rank, same text) when the output must not be
+// touched: it exists and neither --resume nor --overwrite says what to do with it, it is
+// not a superball result, it belongs to another job or version, it is damaged, or it
+// cannot be written.
+ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm);
+
+struct RunSummary {
+    std::filesystem::path output;
+    bool complete = false;           // every tile done, the result closed complete
+    bool interrupted = false;        // stopped on request (resumable)
+    bool nothing_to_do = false;      // the output was already complete
+    std::uint64_t points_this_run = 0;    // points of the tiles done by this run
+    std::uint64_t points_counted = 0;     // of which counted by the kernel (fewer with refinement)
+    std::vector<std::uint64_t> outcomes;  // histogram of this run's points by outcome code
+    double compute_seconds = 0;           // from the first tile handed out to the last one done
+    double peak_rss_mib = 0;              // largest over the ranks
+    int ranks = 1;
+};
+
+// Collective over `comm`: plans (plan_explore), runs and finishes the job. Returns on
+// every rank; the summary's figures are valid on every rank. Throws InputError (every
+// rank) when planning refuses; other exceptions mean the ranks may be out of step, and
+// the caller should end them all (mpi::Comm::abort).
+RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm, RunObserver& observer,
+                       const StopRequested& stop);
+
+}  // namespace superball
