@@ -7,7 +7,7 @@
 
 #include <cerrno>
 #include <chrono>
-#include <deque>
+#include <utility>
 #include <system_error>
 
 #include "core/count.hpp"
@@ -167,7 +167,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
                           : ResultFile::open(plan.output, comm);
     const Tiling& tiling = file.tiling();
 
-    std::deque<std::uint64_t> pending;
+    std::vector<std::uint64_t> pending;
     if (comm.is_root()) {
         RunStart start{plan.output, plan.note, comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(), 0, 0};
         const std::vector<std::uint8_t> done = file.tiles_done();
@@ -181,45 +181,69 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
         }
         observer.started(start);
     }
+    comm.broadcast(pending);
 
-    Starts starts;
-    std::vector<std::uint32_t> counts;
-    std::vector<std::uint8_t> outcomes;
-    std::vector<std::uint64_t> histogram(outcome_count, 0);
-    std::uint64_t counted = 0;  // points counted by the kernel (fewer than the tiles' with refinement)
-    std::uint64_t points_run = 0;
-    TileCounter counter(kernel_for(grid, settings.kernel), job.max_bounces);
-    std::vector<ModelRun> runs;
-    const TileWork work = [&](std::uint64_t t, const Serve& serve) {
-        const Box box = tiling.box(t);
-        grid.starts(box, starts);
-        grid.model_runs(box, runs);
-        counts.resize(starts.size());
-        outcomes.resize(starts.size());
-        if (job.refine != 0) {
-            const CountPoints some = [&](std::span<const std::uint64_t> points) {
-                counter.some(points, starts, runs, counts, outcomes, serve);
-            };
-            counted += refine_tile(box.count, job.refine, some, counts, outcomes);
-        } else {
-            counter.all(starts, runs, counts, outcomes, serve);
-            counted += starts.size();
+    // Counts a tile and writes it at once (TileWork).
+    class Work final : public TileWork {
+    public:
+        Work(const Job& job, const Grid& grid, ResultFile& file, KernelChoice k)
+            : job_(job), grid_(grid), file_(file), counter_(kernel_for(grid, k), job.max_bounces)
+        {
         }
-        file.write_tile(t, counts, outcomes);
-        points_run += starts.size();
-        for (const std::uint8_t o : outcomes) ++histogram[o];
+        void compute(std::uint64_t t, const Serve& serve) override
+        {
+            const Box box = file_.tiling().box(t);
+            grid_.starts(box, starts_);
+            grid_.model_runs(box, runs_);
+            counts_.resize(starts_.size());
+            outcomes_.resize(starts_.size());
+            if (job_.refine != 0) {
+                const CountPoints some = [&](std::span<const std::uint64_t> points) {
+                    counter_.some(points, starts_, runs_, counts_, outcomes_, serve);
+                };
+                counted += refine_tile(box.count, job_.refine, some, counts_, outcomes_);
+            } else {
+                counter_.all(starts_, runs_, counts_, outcomes_, serve);
+                counted += starts_.size();
+            }
+            file_.write_tile(t, counts_, outcomes_);
+            points += starts_.size();
+            for (const std::uint8_t o : outcomes_) ++histogram[o];
+            reports_.push_back({t, 0});
+        }
+        std::vector<TileReport> flush() override { return std::exchange(reports_, {}); }
+
+        std::vector<std::uint64_t> histogram = std::vector<std::uint64_t>(outcome_count, 0);
+        std::uint64_t counted = 0;  // points counted by the kernel (fewer than the tiles' with refinement)
+        std::uint64_t points = 0;
+
+    private:
+        const Job& job_;
+        const Grid& grid_;
+        ResultFile& file_;
+        TileCounter counter_;
+        Starts starts_;
+        std::vector<ModelRun> runs_;
+        std::vector<std::uint32_t> counts_;
+        std::vector<std::uint8_t> outcomes_;
+        std::vector<TileReport> reports_;
+    } work(job, grid, file, settings.kernel);
+    const TilesDone on_done = [&](std::span<const TileReport> tiles, int) {
+        std::uint64_t points = 0;
+        for (const TileReport& r : tiles) points += tiling.box(r.tile).points();
+        observer.tiles_done(tiles.size(), points);
     };
-    const TileDone on_done = [&](std::uint64_t t, int) { observer.tiles_done(1, tiling.box(t).points()); };
     const auto compute_start = std::chrono::steady_clock::now();
-    const ScheduleResult r = run_schedule(comm, std::move(pending), work, on_done, stop);
+    const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop);
     const double compute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - compute_start).count();
     if (comm.is_root()) observer.computed(compute_seconds);
 
     // Attributes are written collectively and must be identical on every rank.
     const double run_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     file.finish(comm.broadcast(run_seconds), comm.size(), !r.interrupted);
-    histogram.push_back(counted);  // summed with the histogram: one reduction
-    histogram.push_back(points_run);
+    std::vector<std::uint64_t> histogram = work.histogram;
+    histogram.push_back(work.counted);  // summed with the histogram: one reduction
+    histogram.push_back(work.points);
     std::vector<std::uint64_t> total = comm.sum(histogram);
     summary.points_this_run = total.back();
     total.pop_back();
