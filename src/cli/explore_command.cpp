@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "core/count.hpp"
+#include "core/kernels.hpp"
 #include "io/hdf5.hpp"
 #include "io/result_file.hpp"
 #include "job/grid.hpp"
@@ -29,10 +30,10 @@ struct ExploreOptions {
     bool overwrite = false;
     bool quiet = false;
     bool dry_run = false;
-    std::string kernel = "simd";
+    std::string kernel;  // empty: $SUPERBALL_KERNEL, else the best variant
 };
 
-void print_summary(const Job& job, const RunSummary& r)
+void print_summary(const Job& job, const RunSummary& r, const KernelVariant& kernel)
 {
     const double s = r.compute_seconds;
     const auto n = r.points_this_run;
@@ -46,6 +47,7 @@ void print_summary(const Job& job, const RunSummary& r)
     }
     fmt::print(stderr, "{}\n", line);
     fmt::print(stderr, "peak memory per rank: {:.1f} MiB (largest rank)\n", r.peak_rss_mib);
+    fmt::print(stderr, "counting kernel: {}\n", describe(kernel));
     fmt::print(stderr, "result: {}\n", r.output.string());
     if (job.refine != 0) {
         fmt::print(stderr, "refinement: {} of {} points counted ({:.1f}%), the others filled from agreeing corners\n",
@@ -103,9 +105,9 @@ int explore(const ExploreOptions& opt)
     const bool root = world.is_root();
     h5::silence_errors();
     try {
+        const KernelVariant& kernel = select_kernel(opt.kernel);
         const Job job = load_job(opt.job);
-        const ExploreSettings settings{opt.output, opt.resume, opt.overwrite,
-                                       opt.kernel == "scalar" ? KernelChoice::scalar : KernelChoice::simd};
+        const ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
         const fs::path out = output_path(job, settings);
         if (opt.dry_run) {
             if (root) print_plan(job, out, world.size());
@@ -113,7 +115,7 @@ int explore(const ExploreOptions& opt)
         }
         TerminalProgress progress(stderr, opt.quiet);
         const RunSummary r = run_explore(job, settings, world, progress, &StopSignals::requested);
-        if (root && !r.nothing_to_do) print_summary(job, r);
+        if (root && !r.nothing_to_do) print_summary(job, r, kernel);
         return r.interrupted ? 1 : 0;
     } catch (const InputError& e) {
         // Every rank reads the same job and gets the same verdict: one message is enough.
@@ -144,9 +146,12 @@ Runner add_explore_command(CLI::App& app)
     auto* overwrite = sub->add_flag("--overwrite", opt->overwrite, "replace an existing output file");
     sub->get_option("--resume")->excludes(overwrite);
     sub->add_flag("-q,--quiet", opt->quiet, "no progress lines");
-    sub->add_option("--kernel", opt->kernel, "counting kernel: simd (vectorised) or scalar; identical results")
-        ->check(CLI::IsMember({"simd", "scalar"}))
-        ->capture_default_str();
+    std::string variants;
+    for (const KernelVariant& k : simd_kernels()) variants += (variants.empty() ? "" : ", ") + std::string(k.name);
+    sub->add_option("--kernel", opt->kernel,
+                    "counting kernel, identical results: simd (the widest variant this processor runs, here " +
+                        describe(best_kernel()) + "), scalar, or a variant of this build (" + variants +
+                        "); default: $SUPERBALL_KERNEL, else simd");
     sub->add_flag("--dry-run", opt->dry_run, "check the job and print the plan (grid, tiles, output) without running");
     return [opt] { return explore(*opt); };
 }

@@ -1,6 +1,57 @@
 #include "mpi.hpp"
 
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
 namespace superball::mpi {
+
+namespace {
+
+bool is_set(const Getenv& getenv, const char* name) { return getenv(name) != nullptr; }
+
+// Whether an MCA parameter file sets `key` (lines `key = value`, `#` comments).
+bool sets_key(std::string_view params, std::string_view key)
+{
+    std::istringstream in{std::string(params)};
+    for (std::string line; std::getline(in, line);) {
+        line = line.substr(0, line.find('#'));
+        const auto eq = line.find('=');
+        if (eq == std::string::npos) continue;
+        std::string_view name(line.data(), eq);
+        while (!name.empty() && (name.front() == ' ' || name.front() == '\t')) name.remove_prefix(1);
+        while (!name.empty() && (name.back() == ' ' || name.back() == '\t')) name.remove_suffix(1);
+        if (name == key) return true;
+    }
+    return false;
+}
+
+std::string user_mca_params(const Getenv& getenv)
+{
+    const char* home = getenv("HOME");
+    if (home == nullptr) return {};
+    std::ifstream in(std::string(home) + "/.openmpi/mca-params.conf");
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+std::string single_node_pml(const Getenv& getenv, std::string_view user_params)
+{
+    if (is_set(getenv, "OMPI_MCA_pml") || is_set(getenv, "OMPI_MCA_mca_base_param_files") ||
+        sets_key(user_params, "pml")) {
+        return {};
+    }
+    if (const char* size = getenv("OMPI_COMM_WORLD_SIZE")) {
+        const char* local = getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+        return local != nullptr && std::string_view(local) == size ? "ob1" : "";
+    }
+    for (const char* launcher : {"PMIX_RANK", "PMI_RANK", "PMI_SIZE", "PMI_FD"}) {
+        if (is_set(getenv, launcher)) return {};
+    }
+    return "ob1";
+}
 
 void check(int code, const char* what)
 {
@@ -13,6 +64,12 @@ void check(int code, const char* what)
 
 Environment::Environment()
 {
+#ifdef OPEN_MPI
+    const Getenv getenv = [](const char* name) { return std::getenv(name); };
+    const std::string pml = single_node_pml(getenv, user_mca_params(getenv));
+    // Never replaces a value (the last argument): single_node_pml() checked there is none.
+    if (!pml.empty()) ::setenv("OMPI_MCA_pml", pml.c_str(), 0);
+#endif
     // Only `explore` starts MPI, so the command-line arguments are not MPI's business.
     check(MPI_Init(nullptr, nullptr), "MPI_Init");
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);

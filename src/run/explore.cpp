@@ -11,7 +11,6 @@
 #include <system_error>
 
 #include "core/count.hpp"
-#include "core/count_simd.hpp"
 #include "io/result_file.hpp"
 #include "io/xdmf.hpp"
 #include "job/grid.hpp"
@@ -114,10 +113,9 @@ double peak_rss_mib()
     return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
 
-CountKernel kernel_for(const Grid& grid, KernelChoice k)
+CountKernel kernel_for(const Grid& grid, CountKernel k)
 {
-    if (grid.on_boundary_plane()) return &count_each_on_plane;
-    return k == KernelChoice::scalar ? &count_each : &count_each_simd;
+    return grid.on_boundary_plane() ? &count_each_on_plane : k;
 }
 
 }  // namespace
@@ -186,7 +184,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     // Counts a tile and writes it at once (TileWork).
     class Work final : public TileWork {
     public:
-        Work(const Job& job, const Grid& grid, ResultFile& file, KernelChoice k)
+        Work(const Job& job, const Grid& grid, ResultFile& file, CountKernel k)
             : job_(job), grid_(grid), file_(file), counter_(kernel_for(grid, k), job.max_bounces)
         {
         }

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/kernels.hpp"
 #include "job/job.hpp"
 #include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
@@ -23,13 +24,11 @@
 
 namespace superball {
 
-enum class KernelChoice { simd, scalar };
-
 struct ExploreSettings {
     std::filesystem::path output;  // the result file; empty: the job's [run] output
     bool resume = false;           // finish an interrupted run of the same job
     bool overwrite = false;        // replace an existing result
-    KernelChoice kernel = KernelChoice::simd;
+    CountKernel kernel = best_kernel().count;  // core/kernels.hpp: select_kernel()
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]
