@@ -25,7 +25,9 @@
 // no longer does). Only these headers are exempt; this file's own code is still checked.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#ifndef __clang__  // GCC's name: clang would warn about an unknown option
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <experimental/simd>
 #pragma GCC diagnostic pop
 

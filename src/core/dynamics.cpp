@@ -11,7 +11,9 @@
 // code is still checked.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Warray-bounds"
+#ifndef __clang__  // GCC's name: clang would warn about an unknown option
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 #pragma GCC diagnostic pop

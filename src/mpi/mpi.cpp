@@ -16,7 +16,7 @@ bool sets_key(std::string_view params, std::string_view key)
 {
     std::istringstream in{std::string(params)};
     for (std::string line; std::getline(in, line);) {
-        line = line.substr(0, line.find('#'));
+        if (const auto comment = line.find('#'); comment != std::string::npos) line.resize(comment);
         const auto eq = line.find('=');
         if (eq == std::string::npos) continue;
         std::string_view name(line.data(), eq);
