@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
 
 namespace superball {
@@ -21,13 +22,6 @@ namespace superball {
 // The rank that schedules calls `serve` from inside its own work every few hundred
 // points, so that waiting ranks get their next block promptly; elsewhere it does nothing.
 using Serve = std::function<void()>;
-
-// What a finished tile tells the scheduler: which tile, and the checksum of its data as
-// written (for the resume journal).
-struct TileReport {
-    std::uint64_t tile = 0;
-    std::uint64_t checksum = 0;
-};
 
 // What a rank does with the tiles it is given.
 class TileWork {
