@@ -49,12 +49,8 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
         h5::make_dimension_scale(d, name);
         axes.push_back(std::move(d));
     }
-    // Links of the layout before netCDF conventions (superball 0.1), for scripts that read
-    // /axes/<name>. Soft links: netCDF-4 and h5netcdf see one variable, not two.
-    {
-        const h5::Id group = h5::create_group(file, "/axes");
-        for (const std::string& name : axis_names) h5::create_soft_link(file, "/" + name, "/axes/" + name);
-    }
+    // No /axes/<name> (the layout of superball 0.1): links there show up in netCDF tools as
+    // a group of duplicate dimensions.
     for (const Coordinate& c : job.grid) {
         if (c.is_range()) continue;
         const h5::Id d = create_doubles(file, "/" + c.name, {});

@@ -89,7 +89,7 @@ class Explore(unittest.TestCase):
         names = ["invalid", "left", "missed", "capped"]
         rng = random.Random(7)
         with h5py.File(out, "r") as f:
-            xi, W = f["axes/xi"][()], f["axes/W"][()]
+            xi, W = f["xi"][()], f["W"][()]
         for _ in range(60):
             i, k = rng.randrange(len(xi)), rng.randrange(len(W))
             r = subprocess.run([SUPERBALL, "count", "--json", "--e-wall", "0.8", "--alpha-wall", "0.6", "--e-floor", "0.85",
@@ -112,7 +112,7 @@ class Explore(unittest.TestCase):
             self.assertEqual((counts.compression, counts.shuffle), ("gzip", True))
             self.assertEqual((outcome.compression, outcome.shuffle), ("gzip", True))
             # Coordinate variables at the root, attached as dimension scales.
-            self.assertEqual(sorted(k for k in f if k not in ("axes",)), ["U", "W", "outcome", "wall_bounces", "xi"])
+            self.assertEqual(sorted(f), ["U", "W", "outcome", "wall_bounces", "xi"])
             for d in (counts, outcome):
                 self.assertEqual([dim[0].name for dim in d.dims], ["/xi", "/W"])
                 self.assertEqual(d.attrs["coordinates"], "U")
@@ -120,7 +120,6 @@ class Explore(unittest.TestCase):
             # Cell centres, computed as SPEC.md section 4 says.
             expect = np.array([0.0 + (i + 0.5) * (1.0 - 0.0) / 61 for i in range(61)])
             np.testing.assert_array_equal(f["xi"][()], expect)
-            np.testing.assert_array_equal(f["axes/xi"][()], expect)  # the layout of superball 0.1, linked
             self.assertEqual(f["W"].dtype, np.float64)
             self.assertEqual(f["U"][()], -1.0)
             for name in ("xi", "U", "W"):
