@@ -209,7 +209,8 @@ void TileWriter::add(std::uint64_t tile, std::span<const std::uint32_t> counts, 
     const Extent& shape = file_.tiling().tile_shape();
     const bool edge = box.points() != n;  // the chunk's points beyond the grid stay zero
     const auto fill = [&](auto& v) {
-        v.resize((b->count + 1) * n);
+        // Grown once and reused: a resize after clear() would zero what is overwritten anyway.
+        if (v.size() < (b->count + 1) * n) v.resize((b->count + 1) * n);
         auto* chunk = v.data() + b->count * n;
         using T = std::remove_reference_t<decltype(*chunk)>;
         if (edge) std::fill(chunk, chunk + n, T{0});
@@ -267,9 +268,6 @@ void TileWriter::complete(Buffer& b)
     written_.insert(written_.end(), b.reports.begin(), b.reports.end());
     b.reports.clear();
     b.count = 0;
-    b.counts16.clear();
-    b.counts32.clear();
-    b.outcomes.clear();
 }
 
 std::vector<TileReport> TileWriter::flush()

@@ -20,7 +20,8 @@
 namespace superball {
 
 // The rank that schedules calls `serve` from inside its own work every few hundred
-// points, so that waiting ranks get their next block promptly; elsewhere it does nothing.
+// points, so that waiting ranks get their next block promptly; elsewhere (and when no
+// other rank waits: a run on one rank) it is empty.
 using Serve = std::function<void()>;
 
 // What a rank does with the tiles it is given.
