@@ -70,8 +70,14 @@ Environment::Environment()
     // Never replaces a value (the last argument): single_node_pml() checked there is none.
     if (!pml.empty()) ::setenv("OMPI_MCA_pml", pml.c_str(), 0);
 #endif
-    // Only `explore` starts MPI, so the command-line arguments are not MPI's business.
-    check(MPI_Init(nullptr, nullptr), "MPI_Init");
+    // The command-line arguments are not MPI's business. FUNNELED: the run's writer threads
+    // (io/posix_file.hpp) make no MPI call, only the main thread does.
+    int provided = MPI_THREAD_SINGLE;
+    check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+    if (provided < MPI_THREAD_FUNNELED) {
+        MPI_Finalize();
+        throw std::runtime_error("MPI_Init_thread: this MPI library cannot run a process with threads (MPI_THREAD_FUNNELED)");
+    }
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
 }
 

@@ -13,6 +13,12 @@
 
 namespace superball::mpi {
 
+// A failure that every rank of a communicator raises alike, so the ranks are still in step:
+// the caller reports it once and exits normally (no MPI_Abort).
+struct CollectiveError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 // Turns an MPI error code into an exception (MPI_ERRORS_RETURN is set on the world
 // communicator by Environment).
 void check(int code, const char* what);
