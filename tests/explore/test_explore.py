@@ -170,6 +170,24 @@ class Explore(unittest.TestCase):
             self.assertGreaterEqual(np.prod(chunks) * 2, 256 * 1024, chunks)
         self.assertLess(os.path.getsize(out), 0.02 * 1024 * 768 * 3)
 
+    def test_ten_billion_points_are_not_filled(self):
+        """Creating the file of a 10^10-point job allocates 30 GB of chunks but writes none of
+        them: the data are never filled, only the journal (9 bytes a tile) and metadata."""
+        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 100000 }\nU = -1.0\n'
+                                      'W = { min = -3.0, max = 3.0, n = 100000 }'))
+        out = self.path("huge.h5")
+        start = time.time()
+        r = self.explore(job, out, 1, ["--stop-after", "0"], expect=1)
+        self.assertIn("--resume", r.stderr)
+        st = os.stat(out + ".partial")
+        self.assertGreaterEqual(st.st_size, 3 * 10**10)        # every chunk allocated...
+        self.assertLess(st.st_blocks * 512, 64 * 2**20, st)     # ...and none written
+        self.assertLess(time.time() - start, 60)
+        # Reading it reads the tiles done, not 30 GB of nothing.
+        info = subprocess.run([SUPERBALL, "info", out], capture_output=True, text=True, timeout=30)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertRegex(info.stdout, r"complete: +no \(0 of \d+ tiles done\)")
+
     def test_uncompressed(self):
         job = self.write_job(job_text(CANONICAL_2D, run="max_bounces = 1000\ncompression = 0"))
         out = self.path("raw.h5")
