@@ -74,18 +74,20 @@ def wall_impacts_per_second(binary, directory):
     """Wall impacts per second of one rank of `binary`, from the summary of a run in which
     every point is capped (max_bounces raised until it takes a quarter of a second). Tests
     that must stop a run part-way size their jobs with it, so that the runs last the same
-    few seconds in a release build and under AddressSanitizer."""
+    few seconds in a release build and under AddressSanitizer. 64 points: enough to fill
+    the widest vector kernel (8 lanes) as the jobs it sizes do; with fewer the kernel is
+    limited by the latency of one batch, and a job sized by it ends twice too early."""
     job, out = os.path.join(directory, "calibrate.toml"), os.path.join(directory, "calibrate.h5")
-    max_bounces = 100000
+    max_bounces = 25000
     while True:
         with open(job, "w") as f:
-            f.write(capped_job(max_bounces))
+            f.write(capped_job(max_bounces, n_xi=8, n_W=8))
         r = subprocess.run([binary, "explore", job, "-o", out, "--overwrite"], capture_output=True, text=True,
                            env=mpi_env(), timeout=300)
         assert r.returncode == 0, r.stderr
-        seconds = float(r.stderr.split("done: 4 points computed in ")[1].split()[0])
+        seconds = float(r.stderr.split("done: 64 points computed in ")[1].split()[0])
         if seconds >= 0.25 or max_bounces >= 10**9:
-            return 4 * max_bounces / max(seconds, 0.01)
+            return 64 * max_bounces / max(seconds, 0.01)
         max_bounces *= 4
 
 
