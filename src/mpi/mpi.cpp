@@ -37,20 +37,28 @@ std::string user_mca_params(const Getenv& getenv)
 
 }  // namespace
 
-std::string single_node_pml(const Getenv& getenv, std::string_view user_params)
+std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view user_params)
 {
-    if (is_set(getenv, "OMPI_MCA_pml") || is_set(getenv, "OMPI_MCA_mca_base_param_files") ||
-        sets_key(user_params, "pml")) {
-        return {};
-    }
+    if (is_set(getenv, "OMPI_MCA_mca_base_param_files")) return {};
+    bool singleton = true;
     if (const char* size = getenv("OMPI_COMM_WORLD_SIZE")) {
         const char* local = getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-        return local != nullptr && std::string_view(local) == size ? "ob1" : "";
+        if (local == nullptr || std::string_view(local) != size) return {};
+        singleton = false;
+    } else {
+        for (const char* launcher : {"PMIX_RANK", "PMI_RANK", "PMI_SIZE", "PMI_FD"}) {
+            if (is_set(getenv, launcher)) return {};
+        }
     }
-    for (const char* launcher : {"PMIX_RANK", "PMI_RANK", "PMI_SIZE", "PMI_FD"}) {
-        if (is_set(getenv, launcher)) return {};
+    std::vector<McaSetting> wanted{{"pml", "ob1"}};
+    if (singleton) wanted.push_back({"ess_singleton_isolated", "1"});
+    std::vector<McaSetting> settings;
+    for (McaSetting& s : wanted) {
+        if (!is_set(getenv, ("OMPI_MCA_" + s.name).c_str()) && !sets_key(user_params, s.name)) {
+            settings.push_back(std::move(s));
+        }
     }
-    return "ob1";
+    return settings;
 }
 
 void check(int code, const char* what)
@@ -66,9 +74,10 @@ Environment::Environment()
 {
 #ifdef OPEN_MPI
     const Getenv getenv = [](const char* name) { return std::getenv(name); };
-    const std::string pml = single_node_pml(getenv, user_mca_params(getenv));
-    // Never replaces a value (the last argument): single_node_pml() checked there is none.
-    if (!pml.empty()) ::setenv("OMPI_MCA_pml", pml.c_str(), 0);
+    for (const McaSetting& s : single_node_mca(getenv, user_mca_params(getenv))) {
+        // Never replaces a value (the last argument): single_node_mca() checked there is none.
+        ::setenv(("OMPI_MCA_" + s.name).c_str(), s.value.c_str(), 0);
+    }
 #endif
     // The command-line arguments are not MPI's business. FUNNELED: the run's writer threads
     // (io/posix_file.hpp) make no MPI call, only the main thread does.

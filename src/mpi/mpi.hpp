@@ -23,24 +23,34 @@ struct CollectiveError : std::runtime_error {
 // communicator by Environment).
 void check(int code, const char* what);
 
-// Open MPI's point-to-point layer (OMPI_MCA_pml) for a run on one node, decided from the
-// environment before MPI_Init. Open MPI's default start-up opens its network transports
-// (UCX, the PSM/PSM2 libraries of the cm layer) whether or not there is a network, which
-// took 0.2-0.3 s of a 0.35 s job on the 2-core test machine; "ob1" (shared memory
-// between the ranks, TCP) starts in a tenth of that and is all one node needs. Returns
-// "ob1" for a singleton (no launcher) and for an Open MPI mpirun whose ranks are all on
-// this node (OMPI_COMM_WORLD_LOCAL_SIZE = OMPI_COMM_WORLD_SIZE); an empty string, leaving
-// Open MPI's choice, when the user chose (OMPI_MCA_pml set, even to nothing, which is also
-// how `mpirun --mca pml X` reaches the ranks; a `pml` line in `user_params`, the text of
-// ~/.openmpi/mca-params.conf; other parameter files named by OMPI_MCA_mca_base_param_files),
-// when the ranks span several nodes (InfiniBand or Omni-Path is then what they need), and
-// when another launcher started the process (srun, MPICH's hydra: PMI or PMIx variables
-// without Open MPI's), which says nothing here about the number of nodes.
+// Open MPI parameters for a run on one node, decided from the environment before MPI_Init
+// (names without the OMPI_MCA_ prefix, with their values). Open MPI's default start-up
+// opens its network transports (UCX, the PSM/PSM2 libraries of the cm layer) whether or not
+// there is a network, and a singleton (a process started without mpirun) first starts a
+// daemon of its own: together 0.2-0.3 s of a 0.35 s job on the 2-core test machine.
+//   pml = ob1                     (shared memory between the ranks, TCP: all one node
+//                                 needs) for a singleton and for an Open MPI mpirun whose
+//                                 ranks are all on this node (OMPI_COMM_WORLD_LOCAL_SIZE =
+//                                 OMPI_COMM_WORLD_SIZE);
+//   ess_singleton_isolated = 1    (no daemon: superball never spawns or connects to other
+//                                 processes) for a singleton.
+// A parameter the user set is left alone: OMPI_MCA_<name> in the environment, even set to
+// nothing (also how `mpirun --mca NAME VALUE` reaches the ranks), or a line in
+// `user_params`, the text of ~/.openmpi/mca-params.conf; and nothing is set when other
+// parameter files are named (OMPI_MCA_mca_base_param_files), when the ranks span several
+// nodes (InfiniBand or Omni-Path is then what they need), or when another launcher started
+// the process (srun, MPICH's hydra: PMI or PMIx variables without Open MPI's), which says
+// nothing here about the number of nodes.
+struct McaSetting {
+    std::string name;
+    std::string value;
+    friend bool operator==(const McaSetting&, const McaSetting&) = default;
+};
 using Getenv = std::function<const char*(const char* name)>;
-std::string single_node_pml(const Getenv& getenv, std::string_view user_params);
+std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view user_params);
 
 // MPI_Init / MPI_Finalize for the lifetime of the object. One per process. With Open MPI,
-// sets OMPI_MCA_pml to single_node_pml() first when that is not empty.
+// sets the parameters of single_node_mca() first.
 class Environment {
 public:
     Environment();

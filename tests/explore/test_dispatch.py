@@ -2,7 +2,7 @@
 """End-to-end tests of what one portable binary decides at start-up: the counting kernel
 variant (`--kernel`, SUPERBALL_KERNEL, `superball --version`), with identical result files
 from every variant this processor runs, and Open MPI's point-to-point layer for runs on one
-node (ob1 unless the user chose)."""
+node (ob1, and no daemon for a singleton, unless the user chose)."""
 import os
 import re
 import shutil
@@ -127,8 +127,9 @@ class KernelDispatch(unittest.TestCase):
 
 
 class SingleNodeStartUp(unittest.TestCase):
-    """Which of Open MPI's point-to-point layers get opened, from its own log
-    (pml_base_verbose): only ob1 when superball chose it, all of them otherwise."""
+    """What Open MPI does at start-up, from its own log: which point-to-point layers it
+    opens (pml_base_verbose; only ob1 when superball chose it) and whether a singleton
+    starts a daemon (ess_base_verbose: the daemon's "hnp" component)."""
 
     def setUp(self):
         self.dir = tempfile.mkdtemp(prefix="superball-startup-")
@@ -139,22 +140,31 @@ class SingleNodeStartUp(unittest.TestCase):
     def tearDown(self):
         shutil.rmtree(self.dir, ignore_errors=True)
 
-    def opened(self, launcher, **env):
+    def log(self, launcher, **env):
         out = os.path.join(self.dir, "r.h5")
         cmd = [*launcher, superball_binary(), "explore", self.job, "-o", out, "--overwrite", "-q"]
         # HOME elsewhere: no ~/.openmpi/mca-params.conf of the user running the tests.
         r = subprocess.run(cmd, capture_output=True, text=True, timeout=120,
-                           env=env_without("OMPI_MCA_pml", "OMPI_MCA_mca_base_param_files", HOME=self.dir,
-                                           OMPI_MCA_pml_base_verbose="10", **env))
+                           env=env_without("OMPI_MCA_pml", "OMPI_MCA_ess_singleton_isolated",
+                                           "OMPI_MCA_mca_base_param_files", HOME=self.dir,
+                                           OMPI_MCA_pml_base_verbose="10", OMPI_MCA_ess_base_verbose="10", **env))
         self.assertEqual(r.returncode, 0, r.stderr)
         log = r.stdout + r.stderr
         if "components_open" not in log:
-            self.skipTest("this MPI does not log its point-to-point layers (not Open MPI?)")
-        return set(re.findall(r"components_open: found loaded component (\w+)", log))
+            self.skipTest("this MPI does not log its components (not Open MPI?)")
+        return log
+
+    def opened(self, launcher, **env):
+        names = set(re.findall(r"components_open: found loaded component (\w+)", self.log(launcher, **env)))
+        return names & {"ob1", "cm", "ucx", "v", "monitoring"}
 
     def test_singleton_and_one_node_mpirun_use_ob1(self):
         self.assertEqual(self.opened([]), {"ob1"})
         self.assertEqual(self.opened([MPIEXEC, "-n", "2", "--oversubscribe"]), {"ob1"})
+
+    def test_singleton_starts_no_daemon(self):
+        self.assertNotIn("component hnp", self.log([]))
+        self.assertIn("component hnp", self.log([], OMPI_MCA_ess_singleton_isolated="0"))
 
     def test_the_users_choice_stands(self):
         self.assertGreater(len(self.opened([], OMPI_MCA_pml="^ucx")), 1)
