@@ -160,12 +160,17 @@ class ParaView(unittest.TestCase):
             self.check_slice(got["slice"], kind, k, label)
 
     def test_relative_name_from_its_directory(self):
-        """./NAME.xmf (a bare NAME.xmf aborts pvpython: README), also through OpenDataFile."""
+        """./NAME.xmf with every reader and OpenDataFile (which picks Xdmf3ReaderS); a bare
+        NAME.xmf with the legacy reader (the Xdmf3 readers look for the data file in a
+        directory named NAME.xmf and abort pvpython: README)."""
         cases, labels = [], []
         for kind, path in self.results.items():
+            name = os.path.basename(sidecar(path))
             for reader in READERS + ("OpenDataFile",):
-                cases.append({"file": "./" + os.path.basename(sidecar(path)), "reader": reader})
+                cases.append({"file": "./" + name, "reader": reader})
                 labels.append((kind, reader))
+            cases.append({"file": name, "reader": "XDMFReader"})
+            labels.append((kind, "XDMFReader, bare name"))
         for (kind, reader), got in zip(labels, self.pvbatch(cases, self.dir)):
             self.check_grid(got, kind, f"{kind} with {reader} from ./")
 
