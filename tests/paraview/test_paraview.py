@@ -202,6 +202,18 @@ class ParaView(unittest.TestCase):
         self.assertIn("slice &amp; &lt;co&gt;&apos;s &quot;1&quot;.h5:/xi", text)
         self.assertNotIn(os.path.dirname(self.results["slice"]), text)  # the bare name: the pair can move
 
+    def test_no_sidecar_where_xdmf_cannot_name_the_result(self):
+        """A colon in the file name (XDMF's FILE:PATH cannot escape it: the legacy reader
+        splits the name, the Xdmf3 readers abort pvpython), or a result named .xmf (its
+        sidecar would overwrite it): the result, and no sidecar."""
+        where = os.path.join(self.dir, "unnamed")
+        os.makedirs(where, exist_ok=True)
+        paths = client_results(where, ["slice"], {"slice": "run:2.h5"})
+        self.assertTrue(h5py.is_hdf5(paths["slice"]))
+        self.assertFalse(os.path.exists(sidecar(paths["slice"])))
+        paths = client_results(where, ["slice"], {"slice": "slice.xmf"})
+        self.assertTrue(h5py.is_hdf5(paths["slice"]))
+
 
 if __name__ == "__main__":
     unittest.main()
