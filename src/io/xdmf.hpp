@@ -24,6 +24,9 @@ namespace superball {
 // extension .xmf.
 std::filesystem::path write_xdmf(const std::filesystem::path& result);
 
+// Why `result` gets no sidecar ("" if it gets one).
+std::string xdmf_unsupported(const std::filesystem::path& result);
+
 // `text` with the five XML special characters escaped.
 std::string xml_escape(std::string_view text);
 
