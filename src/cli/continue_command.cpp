@@ -2,6 +2,7 @@
 // (pseudo-arclength continuation), with their folds, bifurcations and ends.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +21,7 @@ namespace superball::cli {
 namespace {
 
 constexpr int max_period_limit = 8;
+constexpr double default_step = 0.01;
 
 struct ContinueOptions {
     ModelInput model;
@@ -30,7 +32,7 @@ struct ContinueOptions {
     std::int64_t starts = 2000;
     std::uint64_t seed = 1;
     bool corner = false;
-    double step = 0.01;
+    std::optional<double> step;  // default: min(0.01, --max-step)
     double max_step = 0.05;
     double min_step = 1e-7;
     int max_points = 2000;
@@ -98,20 +100,23 @@ ContinuationRun resolve(const ContinueOptions& opt)
         throw InputError(fmt::format("--period = {} is out of range: accepted 1..{}", opt.period, max_period_limit));
     }
     if (opt.starts < 1) throw InputError(fmt::format("--starts = {} is out of range: accepted starts >= 1", opt.starts));
-    if (!(opt.step > 0.0 && std::isfinite(opt.step))) {
-        throw InputError("--step = " + format_double(opt.step) + " is out of range: accepted step > 0");
+    if (!(opt.max_step > 0.0 && std::isfinite(opt.max_step))) {
+        throw InputError("--max-step = " + format_double(opt.max_step) + " is out of range: accepted max-step > 0");
     }
-    if (!(opt.max_step >= opt.step && std::isfinite(opt.max_step))) {
-        throw InputError("--max-step = " + format_double(opt.max_step) + " is out of range: accepted max-step >= --step");
+    const double step = opt.step.value_or(std::min(default_step, opt.max_step));
+    if (!(step > 0.0 && step <= opt.max_step)) {
+        throw InputError("--step = " + format_double(step) + " is out of range: accepted 0 < step <= --max-step (" +
+                         format_double(opt.max_step) + ")");
     }
-    if (!(opt.min_step > 0.0 && opt.min_step <= opt.step)) {
-        throw InputError("--min-step = " + format_double(opt.min_step) + " is out of range: accepted 0 < min-step <= --step");
+    if (!(opt.min_step > 0.0 && opt.min_step <= step)) {
+        throw InputError("--min-step = " + format_double(opt.min_step) + " is out of range: accepted 0 < min-step <= --step (" +
+                         format_double(step) + ")");
     }
     if (opt.max_points < 1) throw InputError(fmt::format("--max-points = {} is out of range: accepted >= 1", opt.max_points));
     if (opt.format != "csv" && opt.format != "json") {
         throw InputError("--format = " + opt.format + " is not a format: accepted csv or json");
     }
-    run.settings = {*opt.min, *opt.max, opt.step, opt.min_step, opt.max_step, opt.max_points};
+    run.settings = {*opt.min, *opt.max, step, opt.min_step, opt.max_step, opt.max_points};
     if (!opt.start.empty()) run.start = parse_start(opt.start);
     run.period = opt.period;
     run.search = {opt.period, opt.starts, opt.seed, opt.corner};
@@ -307,7 +312,7 @@ Runner add_continue_command(CLI::App& app)
     sub->add_option("--starts", opt->starts, "Newton starts of the fixed-point search, >= 1")->capture_default_str();
     sub->add_option("--seed", opt->seed, "seed of the search's starts")->capture_default_str();
     sub->add_flag("--corner", opt->corner, "the search also looks on the corner plane xi = 0");
-    sub->add_option("--step", opt->step, "initial arclength step, > 0")->capture_default_str();
+    sub->add_option("--step", opt->step, "initial arclength step, 0 < step <= --max-step (default: 0.01 or --max-step)");
     sub->add_option("--max-step", opt->max_step, "largest arclength step, >= --step")->capture_default_str();
     sub->add_option("--min-step", opt->min_step, "smallest step before the branch is given up")->capture_default_str();
     sub->add_option("--max-points", opt->max_points, "points per direction of a branch, >= 1")->capture_default_str();

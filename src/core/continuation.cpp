@@ -375,6 +375,11 @@ Position locate(const Context& c, std::size_t j, const Node& a, double h, double
     return std::abs(v_lo) <= std::abs(v_hi) ? Position{n_lo, lo, width} : Position{n_hi, hi, width};
 }
 
+// Appended to the note of an event whose bracket could not be narrowed to the tolerance
+// (the corrector fails near it: G^k is singular there, or a branch point makes the
+// corrector's matrix singular); `bracket` says how far it got.
+constexpr const char* unlocated_note = " (bracket not narrowed: the corrector fails near it)";
+
 std::string bound_note(const System& sys, bool upper)
 {
     return std::string(name(sys.parameter)) + (upper ? " = max" : " = min");
@@ -495,6 +500,7 @@ Direction trace(const Context& c, const Node& start)
             }
             stop = Located{std::move(n), ia, where.h, bound ? Event::end : Event::boundary,
                            bound ? bound_note(c.sys, kind == TestKind::upper_bound) : boundary_note(kind), bracket};
+            if (bracket > location_tolerance * (1.0 + h)) stop->note += unlocated_note;
         }
 
         // Sign changes of the other tests since their last significant value.
@@ -518,6 +524,7 @@ Direction trace(const Context& c, const Node& start)
             Position where = locate(c, j, from, step_h, fa, to, f_to);
             auto what = classify_event(c.tests[j].kind, where.node);
             if (!what) continue;
+            if (where.bracket > location_tolerance * (1.0 + step_h)) what->second += unlocated_note;
             found.push_back({std::move(where.node), i, where.h, what->first, std::move(what->second), where.bracket});
         }
         for (Located& e : found) {

@@ -205,7 +205,7 @@ TEST(Continuation, ElasticFamilyHasNoFalseEvents)
     EXPECT_EQ(corner.note, "xi -> 0");
     EXPECT_NEAR(corner.point.U, -1.0, 1e-9);
     EXPECT_NEAR(corner.point.W, -2.5, 1e-9);
-    EXPECT_EQ(b.points.back().note, "U -> 0");
+    EXPECT_EQ(b.points.back().note.rfind("U -> 0", 0), 0u);
     EXPECT_GT(b.points.size(), 30u);
 }
 
