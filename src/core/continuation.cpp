@@ -49,14 +49,19 @@ bool surface_parameter(Parameter p, bool wall, bool e)
     return p == Parameter::alpha || p == (wall ? Parameter::alpha_wall : Parameter::alpha_floor);
 }
 
-BasicModelMatrices<Dual> dual_matrices(const Model& model, Parameter p)
+// The impact matrices along the path at s = value, each coefficient carrying its
+// derivative in s (the fourth independent variable).
+BasicModelMatrices<Dual> dual_matrices(const ParameterPath& path, double value)
 {
-    const Dual parameter(parameter_value(model, p), 4, 3);
-    const auto matrix = [&](const Surface& s, bool wall) {
-        return BasicImpactMatrix<Dual>::of(surface_parameter(p, wall, true) ? parameter : Dual(s.e),
-                                           surface_parameter(p, wall, false) ? parameter : Dual(s.alpha));
+    const auto coefficient = [value](double origin, double direction) {
+        Dual c(origin + value * direction);
+        c.derivatives()(3) = direction;
+        return c;
     };
-    return {matrix(model.wall, true), matrix(model.floor, false)};
+    const auto matrix = [&](const Surface& o, const Surface& d) {
+        return BasicImpactMatrix<Dual>::of(coefficient(o.e, d.e), coefficient(o.alpha, d.alpha));
+    };
+    return {matrix(path.origin.wall, path.direction.wall), matrix(path.origin.floor, path.direction.floor)};
 }
 
 CanonicalState<double> value_of(const CanonicalState<Dual>& c) { return {c.xi.value(), c.U.value(), c.W.value()}; }
@@ -87,8 +92,7 @@ Eigen::Matrix3d second_compound(const Eigen::Matrix3d& a)
 // ---- The branch equations ------------------------------------------------------------
 
 struct System {
-    Model model;
-    Parameter parameter;
+    ParameterPath path;
     int period;
     bool corner;  // on the plane xi = 0: the equation for xi is xi = 0
 };
@@ -109,8 +113,7 @@ struct Evaluation {
 std::optional<Evaluation> evaluate(const System& sys, const Vector4& y)
 {
     Evaluation e;
-    e.g = parameter_jacobian(as_state(y.head<3>()), with_parameter(sys.model, sys.parameter, y(3)), sys.parameter,
-                             sys.period);
+    e.g = parameter_jacobian(as_state(y.head<3>()), sys.path, y(3), sys.period);
     if (!e.g.finite) return std::nullopt;
     e.H = as_vector(e.g.image) - y.head<3>();
     e.J.leftCols<3>() = e.g.dG - Eigen::Matrix3d::Identity();
@@ -278,7 +281,7 @@ double test_value(const System& sys, const Test& test, const Node& n, const Cont
         case TestKind::xi_one: return 1.0 - point().xi;
         case TestKind::U_zero: return -point().U;
         case TestKind::wall_down: {
-            const ModelMatrices m = ModelMatrices::of(with_parameter(sys.model, sys.parameter, n.y(3)));
+            const ModelMatrices m = ModelMatrices::of(sys.path.at(n.y(3)));
             return -plane_map_xi0(point().U, point().W, m).p;
         }
         case TestKind::lower_bound: return n.y(3) - set.min + bound_slack;
@@ -382,7 +385,7 @@ constexpr const char* unlocated_note = " (bracket not narrowed: the corrector fa
 
 std::string bound_note(const System& sys, bool upper)
 {
-    return std::string(name(sys.parameter)) + (upper ? " = max" : " = min");
+    return sys.path.name + (upper ? " = max" : " = min");
 }
 
 std::string boundary_note(TestKind k)
@@ -578,9 +581,7 @@ BranchPoint describe(const System& sys, const Node& n, double arclength)
     Eigen::Matrix3d dG = n.ev.g.dG;
     if (first != orbit.begin()) {
         // D(G^k) at the representative, as fixed-points computes it (similar to dG).
-        dG = parameter_jacobian(p.representative, with_parameter(sys.model, sys.parameter, p.parameter), sys.parameter,
-                                sys.period)
-                 .dG;
+        dG = parameter_jacobian(p.representative, sys.path, p.parameter, sys.period).dG;
     }
     if (const auto ev = sorted_eigenvalues(dG)) {
         p.eigenvalues = *ev;
@@ -689,9 +690,27 @@ const char* parameter_range_text(Parameter p)
     return e ? e_range_text : alpha_range_text;
 }
 
+Model ParameterPath::at(double s) const
+{
+    const auto surface = [s](const Surface& o, const Surface& d) { return Surface{o.e + s * d.e, o.alpha + s * d.alpha}; };
+    return {surface(origin.wall, direction.wall), surface(origin.floor, direction.floor)};
+}
+
+ParameterPath ParameterPath::along(const Model& model, Parameter p)
+{
+    ParameterPath path{with_parameter(model, p, 0.0), with_parameter(Model{{0.0, 0.0}, {0.0, 0.0}}, p, 1.0),
+                       std::string(superball::name(p))};
+    return path;
+}
+
 ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const Model& model, Parameter p, int k)
 {
-    const BasicModelMatrices<Dual> m = dual_matrices(model, p);
+    return parameter_jacobian(s, ParameterPath::along(model, p), parameter_value(model, p), k);
+}
+
+ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const ParameterPath& path, double value, int k)
+{
+    const BasicModelMatrices<Dual> m = dual_matrices(path, value);
     CanonicalState<Dual> c{Dual(s.xi, 4, 0), Dual(s.U, 4, 1), Dual(s.W, 4, 2)};
     Dual lambda(1.0);
     ParameterJacobian r;
@@ -731,9 +750,14 @@ std::string_view name(Event e)
 std::optional<Branch> continue_cycle(const Cycle& start, const Model& model, Parameter parameter,
                                      const ContinuationSettings& settings)
 {
+    return continue_cycle(start, ParameterPath::along(model, parameter), parameter_value(model, parameter), settings);
+}
+
+std::optional<Branch> continue_cycle(const Cycle& start, const ParameterPath& path, double p0,
+                                     const ContinuationSettings& settings)
+{
     if (start.points.empty() || start.period < 1) return std::nullopt;
-    const System sys{model, parameter, start.period, start.corner};
-    const double p0 = parameter_value(model, parameter);
+    const System sys{path, start.period, start.corner};
     Vector4 y0;
     y0 << as_vector(start.points.front()), p0;
     // The start solved in the branch's own variables (plain coordinates) at its parameter.

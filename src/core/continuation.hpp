@@ -75,6 +75,19 @@ bool parameter_defined(const Model& m, Parameter p);
 bool parameter_in_range(Parameter p, double value);
 const char* parameter_range_text(Parameter p);
 
+// A line in the space of the four coefficients: coefficients(s) = origin + s direction.
+// Continuation in one coefficient follows the line along it (s is its value); an event
+// curve in two coefficients is found on lines across it (continue_event).
+struct ParameterPath {
+    Model origin;
+    Model direction;   // per coefficient, its rate of change with s
+    std::string name;  // what s is, for the notes of events ("alpha", "s")
+
+    Model at(double s) const;
+    // s = the value of p, the other coefficients those of `model`.
+    static ParameterPath along(const Model& model, Parameter p);
+};
+
 // G^k at s with its derivatives in (xi, U, W) and in the parameter, by automatic
 // differentiation. No domain check: G is evaluated wherever its formula is finite,
 // including its analytic extension a little beyond the planes xi = 0 and xi = 1.
@@ -88,6 +101,8 @@ struct ParameterJacobian {
 };
 
 ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const Model& model, Parameter p, int k);
+// The same with the derivative along a path of coefficients, at path.at(value).
+ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const ParameterPath& path, double value, int k);
 
 enum class Event : std::uint8_t { none, fold, period_doubling, neimark_sacker, branch_point, boundary, end };
 
@@ -137,6 +152,10 @@ struct Branch {
 // cycles (start.corner) are followed on the plane. nullopt if the start is not a regular
 // point of the branch equations (the corrector cannot refine it).
 std::optional<Branch> continue_cycle(const Cycle& start, const Model& model, Parameter parameter,
+                                     const ContinuationSettings& settings);
+// The same along a path of coefficients, from s = s0 (start: a cycle of path.at(s0)); the
+// settings' bounds apply to s.
+std::optional<Branch> continue_cycle(const Cycle& start, const ParameterPath& path, double s0,
                                      const ContinuationSettings& settings);
 
 }  // namespace superball
