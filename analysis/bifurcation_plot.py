@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Draw a bifurcation diagram: the branches of cycles `superball continue` followed in one
-coefficient.
+coefficient, or (with its --curve) the curves of their events in the plane of two.
 
 Input is the CSV of `superball continue` (a file, or - for standard input), or `--run
 ARGS...` to call the binary itself (from $SUPERBALL, else `superball` on PATH) as
@@ -15,6 +15,7 @@ import os
 import shutil
 import subprocess
 import sys
+import textwrap
 from typing import NamedTuple
 
 import numpy as np
@@ -60,14 +61,19 @@ QUANTITIES = {
 CROSSING_EVENTS = ("fold", "period_doubling", "neimark_sacker", "branch_point")
 DEFAULT_QUANTITIES = "U,modulus"
 DPI = 100
+# Characters per line of the title (the comment line of the CSV), wrapped to fit.
+TITLE_WIDTH = 100
 PNG_SIZE = (1000, 800)
 
 DESCRIPTION = __doc__ + """
-The figure has one panel per quantity (--y, default %s: U of the cycle's point with the
+Branches: one panel per quantity (--y, default %s: U of the cycle's point with the
 smallest xi, and the largest modulus of the eigenvalues of D(G^k)), against the
 parameter. Each branch has its colour; a stretch where the cycle is stable is drawn
 solid, one where it is not (unstable, saddle, marginal) dashed. Events are marked:
 fold, period doubling, Neimark-Sacker, branch point, boundary, end.
+
+Event curves (`superball continue --curve Q`): the curves in the plane of the two
+coefficients, coloured by the kind of event, each labelled with the branch it came from.
 
 Output: a PNG (-o, default named after the input, else bifurcation.png) and a PDF of
 the same figure next to it (same name, .pdf).
@@ -94,8 +100,30 @@ class Diagram(NamedTuple):
     branches: dict  # branch number -> list of Point, in order along the branch
 
 
-def read_csv(text, source):
-    """Parse `superball continue` CSV; every problem names the source and line."""
+class CurvePoint(NamedTuple):
+    """One row of the event-curve CSV."""
+
+    curve: int
+    branch: int
+    event: str
+    period: int
+    corner: bool
+    first: float
+    second: float
+
+
+class Curves(NamedTuple):
+    parameters: tuple  # (first, second)
+    title: str
+    curves: dict  # curve number -> list of CurvePoint, in order along the curve
+
+
+CURVE_COLUMNS = ("curve", "branch", "event", "period", "corner")
+CURVE_TAIL = VALUE_COLUMNS + ("stability", "note")
+
+
+def split_rows(text, source):
+    """(comment lines, [(line number, fields)]) of a CSV with # comments."""
     if text.lstrip().startswith("{"):
         raise ScriptError(f"{source}: this is JSON; give the CSV of `superball continue` (--format csv)")
     comments = []
@@ -107,6 +135,43 @@ def read_csv(text, source):
             comments.append(",".join(row).lstrip("#").strip())
             continue
         rows.append((n, row))
+    return comments, rows
+
+
+def read_curves(comments, rows, source):
+    """The event curves of `superball continue --curve` (rows[0] is the header)."""
+    header = [field.strip() for field in rows[0][1]]
+    expected = ",".join(CURVE_COLUMNS) + ",P,Q," + ",".join(CURVE_TAIL)
+    if (len(header) != len(CURVE_COLUMNS) + 2 + len(CURVE_TAIL) or tuple(header[:5]) != CURVE_COLUMNS
+            or header[5] not in PARAMETERS or header[6] not in PARAMETERS or tuple(header[7:]) != CURVE_TAIL):
+        raise ScriptError(f"{source}: not a superball continue --curve CSV (expected the header {expected}, "
+                          f"P and Q among {', '.join(PARAMETERS)})")
+    curves = {}
+    for line, row in rows[1:]:
+        if len(row) != len(header):
+            raise ScriptError(f"{source} line {line}: {len(row)} fields, expected {len(header)}")
+        try:
+            point = CurvePoint(int(row[0]), int(row[1]), row[2], int(row[3]), bool(int(row[4])), float(row[5]),
+                               float(row[6]))
+        except ValueError:
+            raise ScriptError(f"{source} line {line}: a field is not a number")
+        if point.event not in EVENT_STYLE:
+            raise ScriptError(f"{source} line {line}: unknown event {point.event!r} (expected {', '.join(EVENT_STYLE)})")
+        if not (math.isfinite(point.first) and math.isfinite(point.second)):
+            raise ScriptError(f"{source} line {line}: {header[5]} or {header[6]} is not finite")
+        curves.setdefault(point.curve, []).append(point)
+    if not curves:
+        raise ScriptError(f"{source}: the CSV has a header but no points")
+    title = comments[0] if comments else f"superball continue: event curves in ({header[5]}, {header[6]})"
+    return Curves((header[5], header[6]), title, curves)
+
+
+def read_csv(text, source):
+    """Parse `superball continue` CSV (branches, or event curves); every problem names the source
+    and line."""
+    comments, rows = split_rows(text, source)
+    if rows and rows[0][1] and rows[0][1][0].strip() == "curve":
+        return read_curves(comments, rows, source)
     expected = "branch,period,corner,PARAMETER," + ",".join(VALUE_COLUMNS + TEXT_COLUMNS + TAIL_COLUMNS)
     if not rows:
         raise ScriptError(f"{source}: no data (expected the header {expected})")
@@ -232,7 +297,31 @@ def draw(diagram, names, size, png, pdf):
                        markerfacecolor="none" if e != "end" else EVENT_STYLE[e][1], markersize=8, label=EVENT_STYLE[e][2])
                 for e in EVENT_STYLE if e in seen_events]
     axes[0].legend(handles=handles, fontsize="small", loc="best")
-    fig.suptitle(diagram.title, fontsize="medium")
+    fig.suptitle("\n".join(textwrap.wrap(diagram.title, TITLE_WIDTH)), fontsize="medium")
+    fig.savefig(png, dpi=DPI)
+    fig.savefig(pdf)
+    pyplot().close(fig)
+    return lines
+
+
+def draw_curves(diagram, size, png, pdf):
+    """The event curves in the plane of the two coefficients; returns the number of lines drawn."""
+    fig = new_figure(size, DPI)
+    ax = fig.subplots()
+    styles = ("-", "--", "-.", ":")
+    lines = 0
+    for n, (number, points) in enumerate(sorted(diagram.curves.items())):
+        first = points[0]
+        _, colour, label = EVENT_STYLE[first.event]
+        where = ", corner" if first.corner else ""
+        ax.plot([p.first for p in points], [p.second for p in points], color=colour, linestyle=styles[n % len(styles)],
+                linewidth=1.6, label=f"curve {number}: {label} of branch {first.branch} (period {first.period}{where})")
+        lines += 1
+    ax.set_xlabel(diagram.parameters[0])
+    ax.set_ylabel(diagram.parameters[1])
+    ax.grid(True, linewidth=0.3, alpha=0.5)
+    ax.legend(fontsize="small", loc="best")
+    fig.suptitle("\n".join(textwrap.wrap(diagram.title, TITLE_WIDTH)), fontsize="medium")
     fig.savefig(png, dpi=DPI)
     fig.savefig(pdf)
     pyplot().close(fig)
@@ -300,7 +389,10 @@ def main(argv=None):
     diagram, name = load(args)
     png = args.output or (os.path.splitext(name)[0] + ".png" if name else "bifurcation.png")
     pdf = os.path.splitext(png)[0] + ".pdf"
-    draw(diagram, args.y, args.size, png, pdf)
+    if isinstance(diagram, Curves):
+        draw_curves(diagram, args.size, png, pdf)
+    else:
+        draw(diagram, args.y, args.size, png, pdf)
     print(png)
     print(pdf)
     return 0

@@ -15,6 +15,7 @@
 #include "mpi/mpi.hpp"
 #include "options.hpp"
 #include "run/continuation.hpp"
+#include "core/event_curve.hpp"
 
 namespace superball::cli {
 
@@ -38,6 +39,11 @@ struct ContinueOptions {
     int max_points = 2000;
     std::string format = "csv";
     std::string output;
+    std::string curve;
+    std::optional<double> curve_min, curve_max;
+    double curve_step = 0.005;
+    double curve_max_step = 0.02;
+    int curve_max_points = 400;
 };
 
 std::string parameter_list()
@@ -67,6 +73,55 @@ CanonicalState<double> parse_start(const std::string& text)
         throw InputError("--start = " + text + " is not a launch toward the wall: accepted 0 <= xi < 1 (0: the corner plane), U < 0");
     }
     return {v[0], v[1], v[2]};
+}
+
+ContinuationRun::Curves resolve_curves(const ContinueOptions& opt, const ContinuationRun& run)
+{
+    const auto second = parameter_named(opt.curve);
+    if (!second) throw InputError("--curve = " + opt.curve + " is not a coefficient: accepted " + parameter_list());
+    if (!independent(run.parameter, *second)) {
+        throw InputError("--curve = " + opt.curve + " moves a coefficient --param " + opt.param +
+                         " moves too: accepted a coefficient independent of it");
+    }
+    if (!parameter_defined(run.model, *second)) {
+        throw InputError("--curve = " + opt.curve + " sets both surfaces, but the wall's and the floor's " + opt.curve +
+                         " differ: use " + opt.curve + "_wall or " + opt.curve + "_floor");
+    }
+    const std::string range = parameter_range_text(*second);
+    for (const auto& [flag, value] : {std::pair{"--curve-min", opt.curve_min}, std::pair{"--curve-max", opt.curve_max}}) {
+        if (!value) throw InputError(std::string(flag) + " is not set: give the bounds of " + opt.curve + " (accepted " + range + ")");
+        if (!parameter_in_range(*second, *value)) {
+            throw InputError(std::string(flag) + " = " + format_double(*value) + " is out of range: accepted " + range);
+        }
+    }
+    if (!(*opt.curve_min < *opt.curve_max)) {
+        throw InputError("--curve-min = " + format_double(*opt.curve_min) + " is not below --curve-max = " +
+                         format_double(*opt.curve_max));
+    }
+    const double q0 = parameter_value(run.model, *second);
+    if (q0 < *opt.curve_min || q0 > *opt.curve_max) {
+        throw InputError("the start's " + opt.curve + " = " + format_double(q0) + " is outside --curve-min " +
+                         format_double(*opt.curve_min) + " --curve-max " + format_double(*opt.curve_max));
+    }
+    if (!(opt.curve_max_step > 0.0 && std::isfinite(opt.curve_max_step))) {
+        throw InputError("--curve-max-step = " + format_double(opt.curve_max_step) + " is out of range: accepted > 0");
+    }
+    if (!(opt.curve_step > 1e-5 && opt.curve_step <= opt.curve_max_step)) {
+        throw InputError("--curve-step = " + format_double(opt.curve_step) +
+                         " is out of range: accepted 1e-05 < curve-step <= --curve-max-step");
+    }
+    if (opt.curve_max_points < 1) {
+        throw InputError(fmt::format("--curve-max-points = {} is out of range: accepted >= 1", opt.curve_max_points));
+    }
+    EventCurveSettings set;
+    set.min1 = *opt.min;
+    set.max1 = *opt.max;
+    set.min2 = *opt.curve_min;
+    set.max2 = *opt.curve_max;
+    set.initial_step = opt.curve_step;
+    set.max_step = opt.curve_max_step;
+    set.max_points = opt.curve_max_points;
+    return {*second, set};
 }
 
 ContinuationRun resolve(const ContinueOptions& opt)
@@ -117,6 +172,7 @@ ContinuationRun resolve(const ContinueOptions& opt)
         throw InputError("--format = " + opt.format + " is not a format: accepted csv or json");
     }
     run.settings = {*opt.min, *opt.max, step, opt.min_step, opt.max_step, opt.max_points};
+    if (!opt.curve.empty()) run.curves = resolve_curves(opt, run);
     if (!opt.start.empty()) run.start = parse_start(opt.start);
     run.period = opt.period;
     run.search = {opt.period, opt.starts, opt.seed, opt.corner};
@@ -145,9 +201,16 @@ std::string start_text(const Cycle& c)
                        p.U, p.W, name(c.stability));
 }
 
-// Doubles as the shortest text that reads back to the same value (fmt's "{}").
-void write_csv(std::FILE* f, const std::vector<ContinuedBranch>& branches, const ContinuationRun& run, int ranks)
+std::string eigenvalue_fields(const std::array<std::complex<double>, 3>& ev)
 {
+    return fmt::format("{},{},{},{},{},{}", ev[0].real(), ev[0].imag(), ev[1].real(), ev[1].imag(), ev[2].real(),
+                       ev[2].imag());
+}
+
+// Doubles as the shortest text that reads back to the same value (fmt's "{}").
+void write_csv(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, int ranks)
+{
+    const std::vector<ContinuedBranch>& branches = result.branches;
     const std::string p = std::string(name(run.parameter));
     fmt::print(f, "# superball continue: {} from {} to {}; model at the start: {}\n", p, run.settings.min,
                run.settings.max, model_text(run.model));
@@ -173,18 +236,60 @@ void write_csv(std::FILE* f, const std::vector<ContinuedBranch>& branches, const
         if (!branches[i].branch) continue;
         const Branch& b = *branches[i].branch;
         for (const BranchPoint& q : b.points) {
-            const auto& ev = q.eigenvalues;
-            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, b.period,
-                       b.domain == Domain::corner ? 1 : 0, q.parameter, q.representative.xi, q.representative.U,
-                       q.representative.W, q.lambda, ev[0].real(), ev[0].imag(), ev[1].real(), ev[1].imag(),
-                       ev[2].real(), ev[2].imag(), name(q.stability), name(q.event), csv_field(q.note), q.residual,
+            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, b.period, b.domain == Domain::corner ? 1 : 0,
+                       q.parameter, q.representative.xi, q.representative.U, q.representative.W, q.lambda,
+                       eigenvalue_fields(q.eigenvalues), name(q.stability), name(q.event), csv_field(q.note), q.residual,
                        q.arclength, q.bracket);
         }
     }
 }
 
-void write_json(std::FILE* f, const std::vector<ContinuedBranch>& branches, const ContinuationRun& run, int ranks)
+std::string curve_text(const ContinuedCurve& c, const ContinuationResult& result, const ContinuationRun& run)
 {
+    const Branch& b = *result.branches[c.branch].branch;
+    const BranchPoint& e = b.points[c.event];
+    const std::string from = fmt::format("{} of branch {} (period {}{}) at {} = {}", name(e.event), c.branch, b.period,
+                                         b.domain == Domain::corner ? " corner" : "", name(run.parameter), e.parameter);
+    if (!c.curve) return from + ": no curve found";
+    return fmt::format("{}: {} points; ends: {}; {}", from, c.curve->points.size(), c.curve->first_end,
+                       c.curve->last_end);
+}
+
+// With --curve: the event curves in the plane of the two coefficients.
+void write_curves_csv(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, int ranks)
+{
+    const std::string p = std::string(name(run.parameter));
+    const std::string q = std::string(name(run.curves->second));
+    const EventCurveSettings& set = run.curves->settings;
+    fmt::print(f, "# superball continue: event curves in ({}, {}), {} from {} to {}, {} from {} to {}; model at the start: {}\n",
+               p, q, p, set.min1, set.max1, q, set.min2, set.max2, model_text(run.model));
+    fmt::print(f, "# {} branch{}, {} event curve{} on {} rank{}; steps {} (initial) to {} in the plane\n",
+               result.branches.size(), result.branches.size() == 1 ? "" : "es", result.curves.size(),
+               result.curves.size() == 1 ? "" : "s", ranks, ranks == 1 ? "" : "s", set.initial_step, set.max_step);
+    for (std::size_t i = 0; i < result.curves.size(); ++i) {
+        fmt::print(f, "# curve {}: {}\n", i, curve_text(result.curves[i], result, run));
+    }
+    fmt::print(f, "# each point: an event located on a line across the curve; (xi, U, W), lambda, ev1..3 and stability\n"
+                  "# of the cycle there as in the branches' output\n");
+    fmt::print(f, "curve,branch,event,period,corner,{},{},xi,U,W,lambda,ev1_re,ev1_im,ev2_re,ev2_im,ev3_re,ev3_im,"
+                  "stability,note\n",
+               p, q);
+    for (std::size_t i = 0; i < result.curves.size(); ++i) {
+        const ContinuedCurve& c = result.curves[i];
+        if (!c.curve) continue;
+        for (const EventCurvePoint& pt : c.curve->points) {
+            const BranchPoint& b = pt.point;
+            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", i, c.branch, name(c.curve->event),
+                       c.curve->period, c.curve->domain == Domain::corner ? 1 : 0, pt.first, pt.second,
+                       b.representative.xi, b.representative.U, b.representative.W, b.lambda,
+                       eigenvalue_fields(b.eigenvalues), name(b.stability), csv_field(b.note));
+        }
+    }
+}
+
+void write_json(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, int ranks)
+{
+    const std::vector<ContinuedBranch>& branches = result.branches;
     const std::string p = std::string(name(run.parameter));
     const Model& m = run.model;
     fmt::print(f, "{{\n  \"model\": {{\"e_wall\": {}, \"alpha_wall\": {}, \"e_floor\": {}, \"alpha_floor\": {}}},\n",
@@ -235,7 +340,45 @@ void write_json(std::FILE* f, const std::vector<ContinuedBranch>& branches, cons
         }
         sep = ",\n";
     }
-    fmt::print(f, "\n  ]\n}}\n");
+    fmt::print(f, "\n  ]");
+    if (run.curves) {
+        const std::string q = std::string(name(run.curves->second));
+        const EventCurveSettings& set = run.curves->settings;
+        fmt::print(f, ",\n  \"curve_parameter\": \"{}\", \"curve_min\": {}, \"curve_max\": {}, \"curves\": [", q, set.min2,
+                   set.max2);
+        sep = "\n";
+        for (std::size_t i = 0; i < result.curves.size(); ++i) {
+            const ContinuedCurve& c = result.curves[i];
+            fmt::print(f, "{}    {{\"curve\": {}, \"branch\": {}, \"event_index\": {}, \"text\": {}", sep, i, c.branch, c.event,
+                       quote(curve_text(c, result, run)));
+            if (!c.curve) {
+                fmt::print(f, ", \"points\": []}}");
+            } else {
+                fmt::print(f, ", \"event\": \"{}\", \"start_index\": {}, \"ends\": [{}, {}], \"points\": [",
+                           name(c.curve->event), c.curve->start, quote(c.curve->first_end), quote(c.curve->last_end));
+                const char* psep = "\n";
+                for (const EventCurvePoint& pt : c.curve->points) {
+                    const BranchPoint& b = pt.point;
+                    fmt::print(f, "{}      {{\"{}\": {}, \"{}\": {}, \"xi\": {}, \"U\": {}, \"W\": {}, \"lambda\": {}, "
+                                  "\"eigenvalues\": [",
+                               psep, name(run.parameter), pt.first, q, pt.second, b.representative.xi, b.representative.U,
+                               b.representative.W, b.lambda);
+                    for (std::size_t k = 0; k < b.eigenvalues.size(); ++k) {
+                        fmt::print(f, "{}{{\"re\": {}, \"im\": {}}}", k ? ", " : "", b.eigenvalues[k].real(),
+                                   b.eigenvalues[k].imag());
+                    }
+                    fmt::print(f, "], \"stability\": \"{}\", \"note\": {}, \"point\": {{\"xi\": {}, \"U\": {}, \"W\": {}}}, "
+                                  "\"residual\": {}, \"bracket\": {}}}",
+                               name(b.stability), quote(b.note), b.point.xi, b.point.U, b.point.W, b.residual, b.bracket);
+                    psep = ",\n";
+                }
+                fmt::print(f, "\n     ]}}");
+            }
+            sep = ",\n";
+        }
+        fmt::print(f, "\n  ]");
+    }
+    fmt::print(f, "\n}}\n");
 }
 
 int run(const ContinueOptions& opt)
@@ -243,10 +386,10 @@ int run(const ContinueOptions& opt)
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
     ContinuationRun cont;
-    std::vector<ContinuedBranch> branches;
+    ContinuationResult result;
     try {
         cont = resolve(opt);
-        branches = continue_branches(cont, world);
+        result = continue_branches(cont, world);
     } catch (const InputError& e) {
         // Every rank checks the same input and gets the same verdict: one message is enough.
         if (world.is_root()) fmt::print(stderr, "superball continue: {}\n", e.what());
@@ -266,9 +409,11 @@ int run(const ContinueOptions& opt)
         f = file.get();
     }
     if (opt.format == "json") {
-        write_json(f, branches, cont, world.size());
+        write_json(f, result, cont, world.size());
+    } else if (cont.curves) {
+        write_curves_csv(f, result, cont, world.size());
     } else {
-        write_csv(f, branches, cont, world.size());
+        write_csv(f, result, cont, world.size());
     }
     if (file && std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + opt.output);
     return 0;
@@ -300,6 +445,11 @@ Runner add_continue_command(CLI::App& app)
         "parameter, xi, U, W (the cycle's point with the smallest xi), lambda, ev1..3 (re, im),\n"
         "stability, event, note, residual, arclength, bracket. Under mpirun the branches are shared among\n"
         "the ranks; the output does not depend on their number.\n"
+        "--curve Q (with --curve-min, --curve-max) then follows every fold, period doubling, Neimark-Sacker\n"
+        "and branch point as a curve in the plane (--param, Q): each curve point is that event located on a\n"
+        "line across the curve (secant predictor); the CSV then lists the curves' points instead (curve,\n"
+        "branch, event, period, corner, the two coefficients, xi, U, W, lambda, ev1..3, stability, note);\n"
+        "the JSON has both.\n"
         "Example: superball continue --e 0.9 --alpha 0.99 --param alpha --min 0.95 --max 1 --corner\n"
         "         | analysis/bifurcation_plot.py - -o alpha.png");
     auto opt = std::make_shared<ContinueOptions>();
@@ -318,6 +468,16 @@ Runner add_continue_command(CLI::App& app)
     sub->add_option("--max-points", opt->max_points, "points per direction of a branch, >= 1")->capture_default_str();
     sub->add_option("--format", opt->format, "csv or json")->capture_default_str();
     sub->add_option("-o,--output", opt->output, "write to this file instead of standard output");
+    const char* curves = "Event curves (two-parameter continuation)";
+    sub->add_option("--curve", opt->curve, "follow every event of the branches as a curve in (--param, this coefficient)")
+        ->group(curves);
+    sub->add_option("--curve-min", opt->curve_min, "lower bound of the --curve coefficient")->group(curves);
+    sub->add_option("--curve-max", opt->curve_max, "upper bound of the --curve coefficient")->group(curves);
+    sub->add_option("--curve-step", opt->curve_step, "initial step in the plane, > 1e-05")->capture_default_str()->group(curves);
+    sub->add_option("--curve-max-step", opt->curve_max_step, "largest step in the plane")->capture_default_str()->group(curves);
+    sub->add_option("--curve-max-points", opt->curve_max_points, "points per direction of a curve, >= 1")
+        ->capture_default_str()
+        ->group(curves);
     return [opt] { return run(*opt); };
 }
 

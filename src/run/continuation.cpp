@@ -89,6 +89,38 @@ Cycle get_cycle(Reader& r)
     return c;
 }
 
+void put_point(Writer& w, const BranchPoint& p)
+{
+    w.put(p.parameter);
+    w.put(p.point);
+    w.put(p.representative);
+    w.put(p.lambda);
+    w.put(p.eigenvalues);
+    w.put(static_cast<double>(p.stability));
+    w.put(p.residual);
+    w.put(p.arclength);
+    w.put(static_cast<double>(p.event));
+    w.put(p.bracket);
+    w.put(p.note);
+}
+
+BranchPoint get_point(Reader& r)
+{
+    BranchPoint p;
+    p.parameter = r.number();
+    p.point = r.state();
+    p.representative = r.state();
+    p.lambda = r.number();
+    p.eigenvalues = r.eigenvalues();
+    p.stability = static_cast<Stability>(r.integer());
+    p.residual = r.number();
+    p.arclength = r.number();
+    p.event = static_cast<Event>(r.integer());
+    p.bracket = r.number();
+    p.note = r.text();
+    return p;
+}
+
 void put_branch(Writer& w, std::size_t index, const std::optional<Branch>& b)
 {
     w.put(static_cast<double>(index));
@@ -98,19 +130,7 @@ void put_branch(Writer& w, std::size_t index, const std::optional<Branch>& b)
     w.put(static_cast<double>(b->domain));
     w.put(static_cast<double>(b->start));
     w.put(static_cast<double>(b->points.size()));
-    for (const BranchPoint& p : b->points) {
-        w.put(p.parameter);
-        w.put(p.point);
-        w.put(p.representative);
-        w.put(p.lambda);
-        w.put(p.eigenvalues);
-        w.put(static_cast<double>(p.stability));
-        w.put(p.residual);
-        w.put(p.arclength);
-        w.put(static_cast<double>(p.event));
-        w.put(p.bracket);
-        w.put(p.note);
-    }
+    for (const BranchPoint& p : b->points) put_point(w, p);
 }
 
 std::pair<std::size_t, std::optional<Branch>> get_branch(Reader& r)
@@ -122,20 +142,47 @@ std::pair<std::size_t, std::optional<Branch>> get_branch(Reader& r)
     b.domain = static_cast<Domain>(r.integer());
     b.start = r.size();
     b.points.resize(r.size());
-    for (BranchPoint& p : b.points) {
-        p.parameter = r.number();
-        p.point = r.state();
-        p.representative = r.state();
-        p.lambda = r.number();
-        p.eigenvalues = r.eigenvalues();
-        p.stability = static_cast<Stability>(r.integer());
-        p.residual = r.number();
-        p.arclength = r.number();
-        p.event = static_cast<Event>(r.integer());
-        p.bracket = r.number();
-        p.note = r.text();
-    }
+    for (BranchPoint& p : b.points) p = get_point(r);
     return {index, std::move(b)};
+}
+
+void put_curve(Writer& w, std::size_t index, const std::optional<EventCurve>& c)
+{
+    w.put(static_cast<double>(index));
+    w.put(c ? 1.0 : 0.0);
+    if (!c) return;
+    w.put(static_cast<double>(c->event));
+    w.put(c->period);
+    w.put(static_cast<double>(c->domain));
+    w.put(static_cast<double>(c->start));
+    w.put(c->first_end);
+    w.put(c->last_end);
+    w.put(static_cast<double>(c->points.size()));
+    for (const EventCurvePoint& p : c->points) {
+        w.put(p.first);
+        w.put(p.second);
+        put_point(w, p.point);
+    }
+}
+
+std::pair<std::size_t, std::optional<EventCurve>> get_curve(Reader& r)
+{
+    const std::size_t index = r.size();
+    if (r.number() == 0.0) return {index, std::nullopt};
+    EventCurve c;
+    c.event = static_cast<Event>(r.integer());
+    c.period = r.integer();
+    c.domain = static_cast<Domain>(r.integer());
+    c.start = r.size();
+    c.first_end = r.text();
+    c.last_end = r.text();
+    c.points.resize(r.size());
+    for (EventCurvePoint& p : c.points) {
+        p.first = r.number();
+        p.second = r.number();
+        p.point = get_point(r);
+    }
+    return {index, std::move(c)};
 }
 
 // The cycles to start from, the same on every rank.
@@ -184,9 +231,49 @@ bool on_branch(const Branch& b, const Cycle& c, const ContinuationRun& run)
     return false;
 }
 
+bool curve_event(Event e)
+{
+    return e == Event::fold || e == Event::period_doubling || e == Event::neimark_sacker || e == Event::branch_point;
+}
+
+// The event curves of the branches (on rank 0), computed curve i on rank i mod size. Every
+// rank needs the branches: rank 0 sends them.
+std::vector<ContinuedCurve> continue_curves(const std::vector<ContinuedBranch>& branches, const ContinuationRun& run,
+                                            const mpi::Comm& comm)
+{
+    Writer all_branches;
+    for (std::size_t i = 0; i < branches.size(); ++i) put_branch(all_branches, i, branches[i].branch);
+    comm.broadcast(all_branches.data());
+    std::vector<std::optional<Branch>> local;
+    Reader r(all_branches.data());
+    while (!r.done()) local.push_back(get_branch(r).second);
+
+    std::vector<ContinuedCurve> jobs;
+    for (std::size_t b = 0; b < local.size(); ++b) {
+        if (!local[b]) continue;
+        for (std::size_t i = 0; i < local[b]->points.size(); ++i) {
+            if (curve_event(local[b]->points[i].event)) jobs.push_back({b, i, std::nullopt});
+        }
+    }
+    Writer mine;
+    for (std::size_t j = static_cast<std::size_t>(comm.rank()); j < jobs.size(); j += static_cast<std::size_t>(comm.size())) {
+        put_curve(mine, j,
+                  continue_event(*local[jobs[j].branch], jobs[j].event, run.model, run.parameter, run.curves->second,
+                                 run.curves->settings));
+    }
+    const std::vector<double> gathered = comm.gather(mine.data());
+    if (!comm.is_root()) return {};
+    Reader g(gathered);
+    while (!g.done()) {
+        auto [index, curve] = get_curve(g);
+        jobs.at(index).curve = std::move(curve);
+    }
+    return jobs;
+}
+
 }  // namespace
 
-std::vector<ContinuedBranch> continue_branches(const ContinuationRun& run, const mpi::Comm& comm)
+ContinuationResult continue_branches(const ContinuationRun& run, const mpi::Comm& comm)
 {
     const std::vector<Cycle> cycles = starts(run, comm);
     Writer mine;
@@ -195,25 +282,28 @@ std::vector<ContinuedBranch> continue_branches(const ContinuationRun& run, const
         put_branch(mine, i, continue_cycle(cycles[i], run.model, run.parameter, run.settings));
     }
     const std::vector<double> all = comm.gather(mine.data());
-    if (!comm.is_root()) return {};
-
-    std::vector<ContinuedBranch> out(cycles.size());
-    for (std::size_t i = 0; i < cycles.size(); ++i) out[i].start = cycles[i];
-    Reader r(all);
-    while (!r.done()) {
-        auto [index, branch] = get_branch(r);
-        out.at(index).branch = std::move(branch);
-    }
-    // In the order of the starts, so the verdict does not depend on who computed what.
-    for (std::size_t j = 0; j < out.size(); ++j) {
-        for (std::size_t i = 0; i < j && !out[j].same_as; ++i) {
-            if (out[i].branch && !out[i].same_as && on_branch(*out[i].branch, out[j].start, run)) {
-                out[j].same_as = i;
-                out[j].branch.reset();
+    ContinuationResult result;
+    if (comm.is_root()) {
+        result.branches.resize(cycles.size());
+        for (std::size_t i = 0; i < cycles.size(); ++i) result.branches[i].start = cycles[i];
+        Reader r(all);
+        while (!r.done()) {
+            auto [index, branch] = get_branch(r);
+            result.branches.at(index).branch = std::move(branch);
+        }
+        // In the order of the starts, so the verdict does not depend on who computed what.
+        auto& out = result.branches;
+        for (std::size_t j = 0; j < out.size(); ++j) {
+            for (std::size_t i = 0; i < j && !out[j].same_as; ++i) {
+                if (out[i].branch && !out[i].same_as && on_branch(*out[i].branch, out[j].start, run)) {
+                    out[j].same_as = i;
+                    out[j].branch.reset();
+                }
             }
         }
     }
-    return out;
+    if (run.curves) result.curves = continue_curves(result.branches, run, comm);
+    return result;
 }
 
 }  // namespace superball

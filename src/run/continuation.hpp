@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/continuation.hpp"
+#include "core/event_curve.hpp"
 #include "mpi/mpi.hpp"
 #include "run/cycles.hpp"
 
@@ -22,6 +23,13 @@ struct ContinuationRun {
     std::optional<CanonicalState<double>> start;
     int period = 1;
     CycleSearch search;
+    // Also follow every fold, period-doubling, Neimark-Sacker and branch point of the
+    // branches as a curve in the plane (parameter, curves->second).
+    struct Curves {
+        Parameter second;
+        EventCurveSettings settings;
+    };
+    std::optional<Curves> curves;
 };
 
 struct ContinuedBranch {
@@ -32,9 +40,21 @@ struct ContinuedBranch {
     std::optional<std::size_t> same_as;
 };
 
-// Collective over `comm`: branch i is continued on rank i mod size. Returns the branches
-// on rank 0 in the order of their starts (empty elsewhere), the same for any number of
-// ranks. Throws InputError when `start` does not converge to a cycle.
-std::vector<ContinuedBranch> continue_branches(const ContinuationRun& run, const mpi::Comm& comm);
+struct ContinuedCurve {
+    std::size_t branch;  // index of the branch (ContinuationResult::branches)
+    std::size_t event;   // index of the event in its points
+    // nullopt when no curve could be followed from it.
+    std::optional<EventCurve> curve;
+};
+
+struct ContinuationResult {
+    std::vector<ContinuedBranch> branches;  // in the order of their starts
+    std::vector<ContinuedCurve> curves;     // by branch, then along it; only with run.curves
+};
+
+// Collective over `comm`: branch i is continued on rank i mod size, then event curve j on
+// rank j mod size. Returns on rank 0 (empty elsewhere), the same for any number of ranks.
+// Throws InputError when `start` does not converge to a cycle.
+ContinuationResult continue_branches(const ContinuationRun& run, const mpi::Comm& comm);
 
 }  // namespace superball
