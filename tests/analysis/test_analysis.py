@@ -87,6 +87,21 @@ branch,period,corner,alpha,xi,U,W,lambda,ev1_re,ev1_im,ev2_re,ev2_im,ev3_re,ev3_
 1,1,1,1,0,-1.0854017419508706,-2.605502682752226,0.9542585225582874,-0.8079642927710479,0.5285319332161582,-0.8079642927710479,-0.5285319332161582,0.9321523028222304,0,stable,end,alpha = max,4.440892098500626e-16,0.016987255933436647,0
 """
 
+# Event curves of `superball continue --e 0.9 --alpha 0.99 --param alpha --min 0.5 --max 1 --start
+# 0,-1.077,-2.595 --curve e --curve-min 0.8 --curve-max 0.99 --curve-step 0.02 --curve-max-step 0.05`,
+# every other point.
+CURVES_CSV = """\
+# superball continue: event curves in (alpha, e), alpha from 0.5 to 1, e from 0.8 to 0.99; model at the start: e_wall 0.9 alpha_wall 0.99 e_floor 0.9 alpha_floor 0.99
+curve,branch,event,period,corner,alpha,e,xi,U,W,lambda,ev1_re,ev1_im,ev2_re,ev2_im,ev3_re,ev3_im,stability,note
+0,0,neimark_sacker,1,1,0.9550499482603967,0.8318585612457468,0,-1.1133773142987877,-2.6362896466064036,0.8577954086139193,1.0963464866853239,0,-0.8364465602814364,0.5480484940161369,-0.8364465602814364,-0.5480484940161369,marginal,angle 2.5615632948844778 rad (0.40768546042362697 turns)
+0,0,neimark_sacker,1,1,0.9685571706327674,0.88,0,-1.0774239837044628,-2.5942033194613368,0.8989563860483383,1.0659810358691508,0,-0.8365957478284982,0.5478207322795247,-0.8365957478284982,-0.5478207322795247,marginal,angle 2.5618355674194877 rad (0.40772879394344197 turns)
+0,0,neimark_sacker,1,1,0.979373235916181,0.92,0,-1.049842602190075,-2.5612211117521113,0.9328762558055007,1.042565950140444,0,-0.8366755760647064,0.5476988044690189,-0.8366755760647064,-0.5476988044690189,marginal,angle 2.561981303270631 rad (0.40775198852453715 turns)
+0,0,neimark_sacker,1,1,0.991999625750505,0.9683798441156666,0,-1.018919815929097,-2.5234914630152434,0.9735796774606408,1.0161948354331618,0,-0.8367259150729787,0.5476218978869326,-0.8367259150729787,-0.5476218978869326,marginal,angle 2.5620732197442795 rad (0.4077666174856699 turns)
+1,0,branch_point,1,1,0.977118040180663,0.8503843331374679,0,-1.1140974144983298,-2.6387703273711716,0.8975875780577885,1.0000000000000007,0,-0.8175671934538136,0.5351107816467127,-0.8175671934538136,-0.5351107816467127,marginal,kappa = 1: an interior branch meets the plane
+1,0,branch_point,1,1,0.9850624493840588,0.9,0,-1.0727659828951444,-2.589360421628216,0.9321697517861585,0.9999999999999969,0,-0.824226819671624,0.5394424704456634,-0.824226819671624,-0.5394424704456634,marginal,kappa = 1: an interior branch meets the plane
+1,0,branch_point,1,1,0.9926489090718339,0.9496623821142001,0,-1.0350321577596613,-2.5434132550566533,0.9661535561991734,1.0000000000000002,0,-0.8305815754055004,0.5435863347053695,-0.8305815754055004,-0.5435863347053695,marginal,kappa = 1: an interior branch meets the plane
+"""
+
 
 def image_size(path):
     with Image.open(path) as image:
@@ -487,6 +502,28 @@ class BifurcationPlotTest(ScriptTestCase):
         moduli = bifurcation_plot.quantity(point, "moduli")
         self.assertAlmostEqual(bifurcation_plot.marker_value(point, "moduli"), 1.0, places=9)
         self.assertEqual(bifurcation_plot.quantity(point, "modulus"), [max(moduli)])
+
+    def test_event_curves_in_the_plane(self):
+        diagram = bifurcation_plot.read_csv(CURVES_CSV, "test")
+        self.assertIsInstance(diagram, bifurcation_plot.Curves)
+        self.assertEqual(diagram.parameters, ("alpha", "e"))
+        self.assertEqual([(n, points[0].event, len(points)) for n, points in sorted(diagram.curves.items())],
+                         [(0, "neimark_sacker", 4), (1, "branch_point", 3)])
+        self.run_script("bifurcation_plot.py", "-", "-o", self.path("c.png"), "--size", "600x500", stdin=CURVES_CSV)
+        self.assertEqual(image_size(self.path("c.png")), (600, 500))
+        self.assertTrue(os.path.isfile(self.path("c.pdf")))
+        seen = colours(image_array(self.path("c.png")))
+        from matplotlib.colors import to_rgb
+
+        for event in ("neimark_sacker", "branch_point"):
+            want = np.array(to_rgb(bifurcation_plot.EVENT_STYLE[event][1])) * 255
+            self.assertTrue(any(np.abs(np.array(c) - want).max() <= 2 for c in seen), event)
+        bad = CURVES_CSV.replace("0,0,neimark_sacker", "0,0,hopf", 1)
+        process = self.run_script("bifurcation_plot.py", "-", stdin=bad, status=2)
+        self.assertIn("hopf", process.stderr)
+        bad = CURVES_CSV.replace("curve,branch,event,period,corner,alpha,e", "curve,branch,event,period,corner,alpha,g")
+        process = self.run_script("bifurcation_plot.py", "-", stdin=bad, status=2)
+        self.assertIn("--curve CSV", process.stderr)
 
     @unittest.skipUnless(HAVE_BINARY, "SUPERBALL does not name a built binary")
     def test_real_superball_output(self):

@@ -12,6 +12,7 @@ Run by ctest as `$SUPERBALL_PYTHON tests/cli/test_continue.py -v` with
 Needs numpy (eigenvalues).
 """
 
+import concurrent.futures
 import csv
 import io
 import json
@@ -31,6 +32,11 @@ PERIOD1 = ["--e", "0.9", "--alpha", "0.99", "--param", "alpha", "--min", "0.95",
 # A period-3 cycle of the same model (from `fixed-points --period 3`): folds, a period doubling.
 PERIOD3 = ["--e", "0.9", "--alpha", "0.99", "--param", "alpha", "--min", "0.98", "--max", "1", "--period", "3",
            "--start", "0.0125,-0.658,-0.54"]
+# The same, with every event followed as a curve in (alpha, e).
+CURVES = ["--e", "0.9", "--alpha", "0.99", "--param", "alpha", "--min", "0.5", "--max", "1", "--corner", "--starts",
+          "100", "--curve", "e", "--curve-min", "0.5", "--curve-max", "0.99"]
+CURVE_COLUMNS = ["curve", "branch", "event", "period", "corner", "alpha", "e", "xi", "U", "W", "lambda", "ev1_re",
+                 "ev1_im", "ev2_re", "ev2_im", "ev3_re", "ev3_im", "stability", "note"]
 COLUMNS = ["branch", "period", "corner", "alpha", "xi", "U", "W", "lambda", "ev1_re", "ev1_im", "ev2_re", "ev2_im",
            "ev3_re", "ev3_im", "stability", "event", "note", "residual", "arclength", "bracket"]
 EVENTS = {"", "fold", "period_doubling", "neimark_sacker", "branch_point", "boundary", "end"}
@@ -318,6 +324,54 @@ class ContinueTest(unittest.TestCase):
             if os.path.exists(out):
                 os.remove(out)
 
+    def test_event_curves(self):
+        """Every event of the branches followed in (alpha, e): the corner fixed point's
+        Neimark-Sacker and branch-point (kappa = 1) curves, the interior one's two Neimark-Sacker
+        curves. Along them the eigenvalues stay on the unit circle (at 1 for the branch point)."""
+        data = Cached.get("curves", *CURVES)
+        self.assertEqual((data["curve_parameter"], data["curve_min"], data["curve_max"]), ("e", 0.5, 0.99))
+        kinds = sorted((c["event"], data["branches"][c["branch"]]["corner"]) for c in data["curves"])
+        self.assertEqual(kinds, [("branch_point", True), ("neimark_sacker", False), ("neimark_sacker", False),
+                                 ("neimark_sacker", True)])
+        for c in data["curves"]:
+            branch = data["branches"][c["branch"]]
+            event = branch["points"][c["event_index"]]
+            start = c["points"][c["start_index"]]
+            self.assertEqual((start["alpha"], start["e"]), (event["alpha"], 0.9))
+            self.assertGreater(len(c["points"]), 15)
+            self.assertTrue(all(0.5 <= p["e"] <= 0.99 and 0.5 <= p["alpha"] <= 1 for p in c["points"]))
+            for p in c["points"]:
+                ev = eigenvalues(p)
+                if c["event"] == "neimark_sacker":
+                    self.assertAlmostEqual(abs(ev[np.argmax(ev.imag)]), 1.0, delta=1e-7)
+                else:
+                    self.assertAlmostEqual(min(abs(ev - 1)), 0.0, delta=1e-7)
+        # Independently, at a point halfway along the corner Neimark-Sacker curve: fixed-points
+        # finds the corner cycle's pair inside the unit circle on one side and outside on the other.
+        (ns,) = [c for c in data["curves"] if c["event"] == "neimark_sacker" and data["branches"][c["branch"]]["corner"]]
+        p = ns["points"][len(ns["points"]) // 2]
+        moduli = []
+        for alpha in (p["alpha"] - 1e-6, p["alpha"] + 1e-6):
+            r = run("fixed-points", "--e", repr(p["e"]), "--alpha", repr(alpha), "--corner", "--starts", "200",
+                    "--format", "json")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            (corner,) = [c for c in json.loads(r.stdout)["cycles"] if c["corner"]]
+            self.assertAlmostEqual(corner["U"], p["U"], delta=1e-4)
+            ev = eigenvalues(corner)
+            moduli.append(abs(ev[np.argmax(ev.imag)]) - 1)
+        self.assertLess(moduli[0] * moduli[1], 0)
+
+    def test_event_curves_csv_and_mpirun(self):
+        data = Cached.get("curves", *CURVES)
+        text = continued(*CURVES, fmt="csv", ranks=2)
+        self.assertIn("on 2 ranks", text)
+        self.assertEqual(text.replace("on 2 ranks", "on 1 rank"), continued(*CURVES, fmt="csv"))
+        lines = [l for l in text.splitlines() if not l.startswith("#")]
+        rows = list(csv.reader(io.StringIO("\n".join(lines))))
+        self.assertEqual(rows[0], CURVE_COLUMNS)
+        self.assertEqual(len(rows) - 1, sum(len(c["points"]) for c in data["curves"]))
+        self.assertEqual(sum(l.startswith("# curve ") for l in text.splitlines()), len(data["curves"]))
+
     def test_bad_input_names_the_flag(self):
         base = ["--e", "0.9", "--alpha", "0.99"]
         rng = ["--param", "alpha", "--min", "0.95", "--max", "1"]
@@ -344,10 +398,21 @@ class ContinueTest(unittest.TestCase):
             (base + rng + ["--max-points", "0"], "--max-points"),
             (base + rng + ["--starts", "0"], "--starts"),
             (["--e", "0.9"] + rng, "--alpha"),
+            (base + rng + ["--curve", "beta", "--curve-min", "0.5", "--curve-max", "1"], "--curve"),
+            (base + rng + ["--curve", "alpha", "--curve-min", "0.5", "--curve-max", "1"], "--curve"),
+            (base + rng + ["--curve", "alpha_wall", "--curve-min", "0.5", "--curve-max", "1"], "--curve"),
+            (base + rng + ["--curve", "e", "--curve-max", "1"], "--curve-min"),
+            (base + rng + ["--curve", "e", "--curve-min", "0.5", "--curve-max", "1.5"], "--curve-max"),
+            (base + rng + ["--curve", "e", "--curve-min", "0.95", "--curve-max", "0.5"], "--curve-min"),
+            (base + rng + ["--curve", "e", "--curve-min", "0.95", "--curve-max", "1"], "outside --curve-min"),
+            (base + rng + ["--curve", "e", "--curve-min", "0.5", "--curve-max", "1", "--curve-step", "0"],
+             "--curve-step"),
         ]
-        for args, flag in cases:
+        # Concurrently: each run waits mostly for MPI's start-up.
+        with concurrent.futures.ThreadPoolExecutor(max_workers=8) as pool:
+            results = list(pool.map(lambda case: run("continue", *case[0]), cases))
+        for (args, flag), r in zip(cases, results):
             with self.subTest(args=args):
-                r = run("continue", *args)
                 self.assertEqual(r.returncode, 2, r.stderr)
                 self.assertIn(flag, r.stderr)
                 self.assertEqual(r.stdout, "")

@@ -12,11 +12,15 @@
 
 #include "core/continuation.hpp"
 #include "core/dynamics.hpp"
+#include "core/event_curve.hpp"
 #include "dynamics_testing.hpp"
 
 namespace superball {
 namespace {
 
+// Event curves (core/event_curve.hpp) are checked the same way: every point is an event of a
+// one-parameter branch, found again by plain continuation in alpha at the point's e.
+//
 // Cycles of e = 0.9, alpha = 0.99 (superball fixed-points --e 0.9 --alpha 0.99 --period 3
 // --corner): the interior fixed point, a period-3 cycle and the corner fixed point.
 const Model dissipative = Model::uniform(0.9, 0.99);
@@ -421,6 +425,144 @@ TEST(Continuation, PeriodDoublingIsARealEigenvalueThroughMinusOne)
         };
         EXPECT_LT(side(q.parameter - 1e-6) * side(q.parameter + 1e-6), 0.0);
     }
+}
+
+// ---- Event curves in (alpha, e) ----------------------------------------------------------
+
+EventCurve curve_of(const Branch& b, Event e, std::size_t nth, double min_e, double max_e)
+{
+    std::size_t seen = 0;
+    for (std::size_t i = 0; i < b.points.size(); ++i) {
+        if (b.points[i].event != e || seen++ != nth) continue;
+        EventCurveSettings s;
+        s.min1 = 0.5;
+        s.max1 = 1.0;
+        s.min2 = min_e;
+        s.max2 = max_e;
+        const auto c = continue_event(b, i, dissipative, Parameter::alpha, Parameter::e, s);
+        EXPECT_TRUE(c.has_value());
+        return c ? *c : EventCurve{};
+    }
+    ADD_FAILURE() << "no " << name(e) << " number " << nth;
+    return {};
+}
+
+// At curve points, plain continuation in alpha with e fixed there finds the same event at the
+// same alpha.
+void expect_curve_matches_one_parameter_continuation(const EventCurve& c, double tolerance)
+{
+    ASSERT_GT(c.points.size(), 6u);
+    int checked = 0;
+    for (std::size_t i = 0; i < c.points.size(); i += std::max<std::size_t>(1, c.points.size() / 8)) {
+        const EventCurvePoint& p = c.points[i];
+        SCOPED_TRACE(testing::Message() << "alpha = " << p.first << ", e = " << p.second);
+        // Started off the event (a start on it would see no change of sign), on the side where
+        // the cycles exist for a fold.
+        std::optional<Cycle> start;
+        double offset = 0.0;
+        for (const double d : {-0.003, 0.003}) {
+            start = reference_cycle(p.point.point, Model::uniform(p.second, p.first + d), Parameter::alpha,
+                                    p.first + d, c.period, c.domain);
+            offset = d;
+            if (start) break;
+        }
+        ASSERT_TRUE(start.has_value());
+        const Model m = Model::uniform(p.second, p.first + offset);
+        ContinuationSettings s;
+        s.min = std::max(0.5, p.first - 0.01);
+        s.max = std::min(1.0, p.first + 0.01);
+        s.max_step = 0.002;
+        const auto b = continue_cycle(*start, m, Parameter::alpha, s);
+        ASSERT_TRUE(b.has_value());
+        double nearest = HUGE_VAL;
+        for (const BranchPoint& q : b->points) {
+            if (q.event == c.event) nearest = std::min(nearest, std::abs(q.parameter - p.first));
+        }
+        EXPECT_LE(nearest, tolerance);
+        ++checked;
+    }
+    EXPECT_GT(checked, 3);
+}
+
+// The corner fixed point's Neimark-Sacker curve: a pair on the unit circle all along, inside on
+// one side and outside on the other (cycles of dynamics.cpp 1e-6 away in alpha).
+TEST(EventCurve, NeimarkSackerCurveOfTheCornerFixedPoint)
+{
+    const EventCurve c = curve_of(dissipative_branches().corner, Event::neimark_sacker, 0, 0.5, 0.99);
+    EXPECT_EQ(c.domain, Domain::corner);
+    EXPECT_EQ(c.points[c.start].second, 0.9);
+    for (std::size_t i = 0; i + 1 < c.points.size(); ++i) {
+        EXPECT_LT(std::hypot(c.points[i + 1].first - c.points[i].first, c.points[i + 1].second - c.points[i].second), 0.03);
+    }
+    for (std::size_t i = 0; i < c.points.size(); i += 5) {
+        const EventCurvePoint& p = c.points[i];
+        SCOPED_TRACE(testing::Message() << "alpha = " << p.first << ", e = " << p.second);
+        EXPECT_EQ(p.point.point.xi, 0.0);
+        EXPECT_NEAR(pair_modulus(p.point.eigenvalues), 1.0, 1e-7);
+        const Model m = Model::uniform(p.second, p.first);
+        const auto side = [&](double alpha) {
+            const auto r = reference_cycle(p.point.point, m, Parameter::alpha, alpha, 1, Domain::corner);
+            EXPECT_TRUE(r.has_value());
+            return r ? pair_modulus(r->eigenvalues) - 1.0 : 0.0;
+        };
+        EXPECT_LT(side(p.first - 1e-6) * side(p.first + 1e-6), 0.0);
+    }
+    expect_curve_matches_one_parameter_continuation(c, 1e-8);
+    // It spans the whole e range asked for.
+    const auto [lo, hi] = std::minmax_element(c.points.begin(), c.points.end(),
+                                              [](const auto& a, const auto& b) { return a.second < b.second; });
+    EXPECT_LT(lo->second, 0.52);
+    EXPECT_GT(hi->second, 0.97);
+}
+
+// The corner fixed point's branch-point curve (kappa = 1), where interior fixed points are born
+// at the corner plane: kappa = 1 of the corner cycle of dynamics.cpp along it.
+TEST(EventCurve, BranchPointCurveWhereInteriorFixedPointsMeetTheCorner)
+{
+    const EventCurve c = curve_of(dissipative_branches().corner, Event::branch_point, 0, 0.5, 0.99);
+    for (std::size_t i = 0; i < c.points.size(); i += 5) {
+        const EventCurvePoint& p = c.points[i];
+        SCOPED_TRACE(testing::Message() << "alpha = " << p.first << ", e = " << p.second);
+        const auto r = reference_cycle(p.point.point, Model::uniform(p.second, p.first), Parameter::alpha, p.first, 1,
+                                       Domain::corner);
+        ASSERT_TRUE(r.has_value());
+        const double kappa = iterate_jacobian(r->points.front(), ModelMatrices::of(Model::uniform(p.second, p.first)), 1,
+                                              Domain::corner)
+                                 .dG(0, 0);
+        EXPECT_NEAR(kappa, 1.0, 1e-7);
+    }
+    expect_curve_matches_one_parameter_continuation(c, 1e-8);
+}
+
+// A fold curve of the period-3 cycle, followed where it turns: an eigenvalue 1 along it, and the
+// fold found again by continuation in alpha.
+TEST(EventCurve, FoldCurveOfAPeriod3Cycle)
+{
+    const Branch b = branch_of(period3_start, dissipative, Parameter::alpha, 3, 0.98, 1.0);
+    const EventCurve c = curve_of(b, Event::fold, 0, 0.85, 0.95);
+    for (const EventCurvePoint& p : c.points) {
+        const auto ev1 = std::min_element(p.point.eigenvalues.begin(), p.point.eigenvalues.end(),
+                                          [](auto x, auto y) { return std::abs(x - 1.0) < std::abs(y - 1.0); });
+        EXPECT_LT(std::abs(*ev1 - 1.0), 1e-6) << "alpha = " << p.first << ", e = " << p.second;
+    }
+    expect_curve_matches_one_parameter_continuation(c, 1e-8);
+}
+
+TEST(EventCurve, RefusesWhatIsNoCurve)
+{
+    const Branch& b = dissipative_branches().corner;
+    EventCurveSettings s;
+    // An end point is no event to follow; alpha and alpha_wall are not independent.
+    EXPECT_FALSE(continue_event(b, 0, dissipative, Parameter::alpha, Parameter::e, s));
+    for (std::size_t i = 0; i < b.points.size(); ++i) {
+        if (b.points[i].event == Event::neimark_sacker) {
+            EXPECT_FALSE(continue_event(b, i, dissipative, Parameter::alpha, Parameter::alpha_wall, s));
+        }
+    }
+    EXPECT_TRUE(independent(Parameter::alpha, Parameter::e));
+    EXPECT_TRUE(independent(Parameter::e_wall, Parameter::e_floor));
+    EXPECT_FALSE(independent(Parameter::e, Parameter::e_floor));
+    EXPECT_FALSE(independent(Parameter::alpha, Parameter::alpha));
 }
 
 }  // namespace
