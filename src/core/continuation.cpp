@@ -141,6 +141,21 @@ struct Node {
     int iterations = 0;
 };
 
+// The null vector of a 3 x 4 matrix of rank 3: its signed 3 x 3 minors (the generalised cross
+// product). Zero when the rank is lower.
+Vector4 null_vector(const Eigen::Matrix<double, 3, 4>& J)
+{
+    Vector4 t;
+    for (int j = 0; j < 4; ++j) {
+        Eigen::Matrix3d minor;
+        for (int c = 0, k = 0; c < 4; ++c) {
+            if (c != j) minor.col(k++) = J.col(c);
+        }
+        t(j) = (j % 2 == 0 ? 1.0 : -1.0) * minor.determinant();
+    }
+    return t;
+}
+
 // Unit null vector of J, oriented so that t . orientation > 0: the solution of
 // [J; orientation^T] z = (0, 0, 0, 1), normalised.
 std::optional<Vector4> tangent(const System& sys, const Eigen::Matrix<double, 3, 4>& J, const Vector4& orientation)
@@ -191,8 +206,7 @@ std::optional<Node> step(const System& sys, const Node& a, double h, int iterati
     return correct(sys, a.y + h * a.t, a.t, a.t.dot(a.y) + h, a.t, iterations);
 }
 
-// Natural-parameter Newton at p = value from y (minimum-norm steps, which also converge
-// where H_x is singular).
+// Natural-parameter Newton at p = value from y.
 std::optional<Node> solve_at_parameter(const System& sys, Vector4 y, double value, const Vector4& orientation)
 {
     y(3) = value;
@@ -200,8 +214,10 @@ std::optional<Node> solve_at_parameter(const System& sys, Vector4 y, double valu
         if (sys.corner) y(0) = 0.0;
         const auto ev = evaluate(sys, y);
         if (!ev) return std::nullopt;
+        // Full pivoting: where H_x is singular to rounding (a family of cycles at fixed p, a
+        // fold on the bound) the step leaves the free direction alone.
         const Eigen::Matrix3d hx = ev->J.leftCols<3>();
-        const Eigen::Vector3d d = -hx.jacobiSvd(Eigen::ComputeFullU | Eigen::ComputeFullV).solve(ev->H);
+        const Eigen::Vector3d d = -hx.fullPivLu().solve(ev->H);
         if (!d.allFinite()) return std::nullopt;
         y.head<3>() += d;
         if (d.norm() <= corrector_tolerance * (1.0 + y.norm())) {
@@ -764,9 +780,9 @@ std::optional<Branch> continue_cycle(const Cycle& start, const ParameterPath& pa
     auto first = evaluate(sys, y0);
     if (!first) return std::nullopt;
     // Initial tangent: the null vector of [H_x H_p]; forward is increasing p.
-    const Eigen::JacobiSVD<Eigen::Matrix<double, 3, 4>> svd(first->J, Eigen::ComputeFullV);
-    Vector4 t = svd.matrixV().col(3);
+    Vector4 t = null_vector(first->J);
     if (sys.corner) t(0) = 0.0;
+    if (!(t.norm() > 0.0) || !t.allFinite()) return std::nullopt;
     t.normalize();
     if (std::abs(t(3)) > significance) {
         if (t(3) < 0.0) t = -t;
