@@ -209,9 +209,12 @@ class Result:
             )
         self.axes = {}
         for name, n in zip(self.axis_names, self.counts.shape):
-            dataset = self.file.get(f"axes/{name}")
+            # A coordinate variable at the root (netCDF layout); /axes/<name> in files of superball 0.1.
+            dataset = self.file.get(name)
+            if not isinstance(dataset, h5py.Dataset):
+                dataset = self.file.get(f"axes/{name}")
             if not isinstance(dataset, h5py.Dataset) or dataset.shape != (n,):
-                raise ScriptError(f"{self.path}: /axes/{name} is missing or does not hold {n} samples")
+                raise ScriptError(f"{self.path}: /{name} is missing or does not hold {n} samples")
             self.axes[name] = dataset[()].astype(np.float64)
 
     def _axis_names(self):
@@ -240,7 +243,7 @@ class Result:
     @property
     def coordinates(self):
         """'canonical' or 'physical' (attribute coordinates; inferred from axis names if absent)."""
-        value = self.attrs.get("coordinates")
+        value = self.attrs.get("coordinate_system", self.attrs.get("coordinates"))
         if value in COORDINATE_NAMES:
             return value
         physical = any(n in COORDINATE_NAMES["physical"] for n in self.axis_names)

@@ -49,8 +49,10 @@ def descendants(pid):
 
 def capped_job(max_bounces, n_xi=2, n_W=2, tile_points=None):
     """A job in which every point bounces to the cap: around the marginally stable
-    self-retracing motion (0.25, -0.5, -1.25) of the dissipation-free model."""
-    run = f"max_bounces = {max_bounces}" + (f"\ntile_points = {tile_points}" if tile_points else "")
+    self-retracing motion (0.25, -0.5, -1.25) of the dissipation-free model. The resume
+    journal is written every 0.1 s."""
+    run = (f"max_bounces = {max_bounces}" + (f"\ntile_points = {tile_points}" if tile_points else "") +
+           "\ncheckpoint_seconds = 0.1")
     return ("[model]\ne = 1.0\nalpha = 1.0\n\n[grid]\n"
             f"xi = {{ min = 0.24, max = 0.26, n = {n_xi} }}\nU = -0.5\nW = {{ min = -1.27, max = -1.23, n = {n_W} }}\n\n"
             f"[run]\n{run}\n")
@@ -60,11 +62,12 @@ def killable_job(speed, seconds):
     """No dissipation over the (xi, W) slice at U = -1: about 11000 of its 300^2 points
     bounce to the cap, max_bounces set from `speed` (wall_impacts_per_second) so that two
     ranks take about `seconds`, in tiles of 400 points that each take a fraction of a
-    second (a clean stop is quick)."""
+    second (a clean stop is quick); the resume journal is written every 0.1 s, so a kill
+    part-way leaves tiles recorded done."""
     max_bounces = max(100, int(2 * seconds * speed / 11000))
     return ("[model]\ne = 1.0\nalpha = 1.0\n\n[grid]\n"
             "xi = { min = 0.0, max = 1.0, n = 300 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 300 }\n\n"
-            f"[run]\nmax_bounces = {max_bounces}\ntile_points = 400\n")
+            f"[run]\nmax_bounces = {max_bounces}\ntile_points = 400\ncheckpoint_seconds = 0.1\n")
 
 
 def wall_impacts_per_second(binary, directory):
@@ -84,3 +87,45 @@ def wall_impacts_per_second(binary, directory):
         if seconds >= 0.25 or max_bounces >= 10**9:
             return 4 * max_bounces / max(seconds, 0.01)
         max_bounces *= 4
+
+
+def tile_boxes(shape, tile_shape):
+    """The boxes (tuples of slices) of the tiles of a grid, in tile order (row-major)."""
+    import itertools
+    per_axis = [range(0, n, t) for n, t in zip(shape, tile_shape)]
+    return [tuple(slice(s, min(s + t, n)) for s, t, n in zip(start, tile_shape, shape))
+            for start in itertools.product(*per_axis)]
+
+
+def tile_checksum(dataset_counts, dataset_outcomes, tile, origin):
+    """The checksum the partial file records for a tile, computed independently of
+    superball: XXH3-64 of the tile's chunk of /wall_bounces, as stored, seeded with the tile's
+    number, then of its chunk of /outcome seeded with that."""
+    import xxhash  # Debian's python3-xxhash
+    counts = dataset_counts.id.read_direct_chunk(origin)[1]
+    outcomes = dataset_outcomes.id.read_direct_chunk(origin)[1]
+    return xxhash.xxh3_64_intdigest(outcomes, seed=xxhash.xxh3_64_intdigest(counts, seed=tile))
+
+
+def interrupted_run(binary, job, out, reference, done):
+    """The partial file (OUT.partial) of an interrupted run of `job`: a run stopped before its
+    first tile (--stop-after 0), then the tiles t with done(t) filled with `reference`'s
+    values and recorded done with their checksums, as the run would have. Returns its path."""
+    import h5py
+    r = subprocess.run([binary, "explore", job, "-o", out, "-q", "--stop-after", "0"], capture_output=True, text=True,
+                       env=mpi_env(), timeout=300)
+    assert r.returncode == 1, r.stderr
+    partial = out + ".partial"
+    with h5py.File(reference, "r") as ref, h5py.File(partial, "r+") as f:
+        counts, outcomes = f["wall_bounces"], f["outcome"]
+        flags, sums = f["progress/tile_done"][()], f["progress/tile_checksum"][()]
+        for t, box in enumerate(tile_boxes(counts.shape, [int(n) for n in f.attrs["tile_shape"]])):
+            if not done(t):
+                continue
+            counts[box] = ref["wall_bounces"][box]
+            outcomes[box] = ref["outcome"][box]
+            sums[t] = tile_checksum(counts, outcomes, t, tuple(s.start for s in box))
+            flags[t] = 1
+        f["progress/tile_checksum"][...] = sums
+        f["progress/tile_done"][...] = flags
+    return partial

@@ -1,5 +1,11 @@
 #include "hdf5.hpp"
 
+#include <H5DSpublic.h>
+
+#include <algorithm>
+#include <fstream>
+#include <initializer_list>
+
 namespace superball::h5 {
 
 void silence_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
@@ -13,8 +19,164 @@ std::string error_detail()
         return 0;
     };
     H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, first, &innermost);
+    // The file drivers' reports run to several lines ("file write failed: time = ...,
+    // filename = ..., errno = 28, error message = 'No space left on device', ..."): keep
+    // what they failed at and the system's reason.
+    const std::string key = "error message = '";
+    if (const auto at = innermost.find(key); at != std::string::npos) {
+        const auto end = innermost.find('\'', at + key.size());
+        const auto colon = innermost.find(':');
+        return innermost.substr(0, colon) + ": " + innermost.substr(at + key.size(), end - at - key.size());
+    }
     return innermost;
 }
+
+// ------------------------------------------------------------------------------- files
+
+bool is_hdf5(const std::filesystem::path& path)
+{
+    // HDF5 looks for its signature at 0, 512, 1024, ... (a user block may come first);
+    // read it ourselves: H5Fis_hdf5 reports failure and "not HDF5" alike.
+    static constexpr char signature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+    std::ifstream in(path, std::ios::binary);
+    char buf[8];
+    for (std::streamoff at = 0; in; at = at == 0 ? 512 : at * 2) {
+        in.seekg(at);
+        if (!in.read(buf, sizeof buf)) return false;
+        if (std::equal(buf, buf + 8, signature)) return true;
+        if (at >= (std::streamoff{1} << 30)) return false;
+    }
+    return false;
+}
+
+Id create_file(const std::filesystem::path& path, hid_t fapl)
+{
+    return file_id(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), "create " + path.string());
+}
+
+Id open_file(const std::filesystem::path& path, bool writable, hid_t fapl)
+{
+    return file_id(H5Fopen(path.c_str(), writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl), "open " + path.string());
+}
+
+Id file_access(std::uint64_t alignment)
+{
+    Id fapl = plist_id(H5Pcreate(H5P_FILE_ACCESS), "H5Pcreate");
+    check(H5Pset_libver_bounds(fapl, H5F_LIBVER_V110, H5F_LIBVER_LATEST), "H5Pset_libver_bounds");
+    if (alignment > 1) check(H5Pset_alignment(fapl, alignment, alignment), "H5Pset_alignment");
+    return fapl;
+}
+
+// ------------------------------------------------------------------------------ objects
+
+ObjectType object_type(hid_t loc, const std::string& path)
+{
+    // Every component must exist before H5Oget_info_by_name may be asked about the last.
+    std::size_t at = path.front() == '/' ? 1 : 0;
+    for (;;) {
+        const std::size_t slash = path.find('/', at);
+        const std::string prefix = path.substr(0, slash);
+        if (check(H5Lexists(loc, prefix.c_str(), H5P_DEFAULT), "H5Lexists " + prefix) <= 0) return ObjectType::missing;
+        if (check(H5Oexists_by_name(loc, prefix.c_str(), H5P_DEFAULT), "H5Oexists " + prefix) <= 0) {
+            return ObjectType::missing;  // a dangling soft link
+        }
+        if (slash == std::string::npos) break;
+        at = slash + 1;
+    }
+    H5O_info_t info{};
+    check(H5Oget_info_by_name2(loc, path.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT), "H5Oget_info " + path);
+    switch (info.type) {
+        case H5O_TYPE_GROUP: return ObjectType::group;
+        case H5O_TYPE_DATASET: return ObjectType::dataset;
+        default: return ObjectType::other;
+    }
+}
+
+Id open_dataset(hid_t loc, const std::string& path)
+{
+    return dataset_id(H5Dopen2(loc, path.c_str(), H5P_DEFAULT), "open " + path);
+}
+
+Id create_group(hid_t loc, const std::string& path)
+{
+    return group_id(H5Gcreate2(loc, path.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "create " + path);
+}
+
+void create_soft_link(hid_t loc, const std::string& target, const std::string& path)
+{
+    check(H5Lcreate_soft(target.c_str(), loc, path.c_str(), H5P_DEFAULT, H5P_DEFAULT), "link " + path);
+}
+
+std::uint64_t Shape::elements() const
+{
+    std::uint64_t n = 1;
+    for (const hsize_t d : dims) n *= d;
+    return n;
+}
+
+namespace {
+
+Shape shape_of(hid_t type, hid_t space)
+{
+    Shape s;
+    switch (H5Tget_class(type)) {
+        case H5T_INTEGER:
+            s.type = TypeClass::integer;
+            s.is_signed = H5Tget_sign(type) == H5T_SGN_2;
+            break;
+        case H5T_FLOAT: s.type = TypeClass::floating; break;
+        case H5T_STRING: s.type = TypeClass::string; break;
+        default: s.type = TypeClass::other; break;
+    }
+    s.bytes = H5Tget_size(type);
+    const H5S_class_t cls = H5Sget_simple_extent_type(space);
+    s.scalar = cls == H5S_SCALAR;
+    if (cls == H5S_SIMPLE) {
+        const int rank = check(H5Sget_simple_extent_ndims(space), "H5Sget_simple_extent_ndims");
+        s.dims.resize(static_cast<std::size_t>(rank));
+        check(H5Sget_simple_extent_dims(space, s.dims.data(), nullptr), "H5Sget_simple_extent_dims");
+    } else if (cls == H5S_NULL) {
+        s.dims = {0};
+    }
+    return s;
+}
+
+}  // namespace
+
+Shape dataset_shape_of(hid_t dataset)
+{
+    const Id type = type_id(H5Dget_type(dataset), "H5Dget_type");
+    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space");
+    return shape_of(type, space);
+}
+
+std::vector<hsize_t> dataset_shape(hid_t dataset)
+{
+    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space");
+    const int rank = check(H5Sget_simple_extent_ndims(space), "H5Sget_simple_extent_ndims");
+    std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+    check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), "H5Sget_simple_extent_dims");
+    return dims;
+}
+
+std::uint64_t contiguous_offset(hid_t dataset)
+{
+    const haddr_t a = H5Dget_offset(dataset);
+    if (a == HADDR_UNDEF) throw Error("HDF5: H5Dget_offset failed (not a contiguous dataset with its space allocated)");
+    return a;
+}
+
+std::uint64_t chunk_offset(hid_t dataset, const std::vector<hsize_t>& coords)
+{
+    unsigned filter_mask = 0;
+    haddr_t addr = HADDR_UNDEF;
+    hsize_t size = 0;
+    check(H5Dget_chunk_info_by_coord(dataset, coords.data(), &filter_mask, &addr, &size), "H5Dget_chunk_info_by_coord");
+    if (addr == HADDR_UNDEF) throw Error("HDF5: chunk not allocated");
+    return addr;
+}
+
+// --------------------------------------------------------------------------- attributes
 
 namespace {
 
@@ -46,12 +208,22 @@ Id open_attribute(hid_t obj, const std::string& name)
     return attribute_id(H5Aopen(obj, name.c_str(), H5P_DEFAULT), "H5Aopen " + name);
 }
 
+// The attribute, checked to hold exactly one value of the given class.
+Id open_scalar(hid_t obj, const std::string& name, std::initializer_list<TypeClass> accepted, const char* expected)
+{
+    Id attr = open_attribute(obj, name);
+    const Id type = type_id(H5Aget_type(attr), "H5Aget_type");
+    const Id space = space_id(H5Aget_space(attr), "H5Aget_space");
+    const Shape s = shape_of(type, space);
+    if (std::find(accepted.begin(), accepted.end(), s.type) == accepted.end() || s.elements() != 1) {
+        throw Error("attribute " + name + " is not " + expected);
+    }
+    return attr;
+}
+
 }  // namespace
 
-void write_attribute(hid_t obj, const std::string& name, double value)
-{
-    write_scalar(obj, name, H5T_NATIVE_DOUBLE, value);
-}
+void write_attribute(hid_t obj, const std::string& name, double value) { write_scalar(obj, name, H5T_NATIVE_DOUBLE, value); }
 
 void write_attribute(hid_t obj, const std::string& name, std::int64_t value)
 {
@@ -65,46 +237,63 @@ void write_attribute(hid_t obj, const std::string& name, const std::string& valu
     write_scalar(obj, name, type, p);
 }
 
+void write_attribute(hid_t obj, const std::string& name, const char* value) { write_attribute(obj, name, std::string(value)); }
+
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values)
 {
     const Id type = variable_string_type();
     std::vector<const char*> p;
     for (const auto& v : values) p.push_back(v.c_str());
-    const hsize_t n = p.size();
-    const Id space = space_id(H5Screate_simple(1, &n, nullptr), "H5Screate_simple");
+    const Id space = simple_space({p.size()});
     const Id attr = create_attribute(obj, name, type, space);
     check(H5Awrite(attr, type, p.data()), "H5Awrite " + name);
 }
 
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::uint64_t>& values)
 {
-    const hsize_t n = values.size();
-    const Id space = space_id(H5Screate_simple(1, &n, nullptr), "H5Screate_simple");
-    const Id attr = create_attribute(obj, name, H5T_NATIVE_UINT64, space);
+    const Id space = simple_space({values.size()});
+    const Id attr = create_attribute(obj, name, H5T_STD_U64LE, space);
     check(H5Awrite(attr, H5T_NATIVE_UINT64, values.data()), "H5Awrite " + name);
+}
+
+void write_attribute(hid_t obj, const std::string& name, std::span<const std::uint8_t> values)
+{
+    const Id space = simple_space({values.size()});
+    const Id attr = create_attribute(obj, name, H5T_STD_U8LE, space);
+    check(H5Awrite(attr, H5T_NATIVE_UINT8, values.data()), "H5Awrite " + name);
 }
 
 bool has_attribute(hid_t obj, const std::string& name) { return check(H5Aexists(obj, name.c_str()), "H5Aexists") > 0; }
 
+std::optional<Shape> attribute_shape(hid_t obj, const std::string& name)
+{
+    if (!has_attribute(obj, name)) return std::nullopt;
+    const Id attr = open_attribute(obj, name);
+    const Id type = type_id(H5Aget_type(attr), "H5Aget_type");
+    const Id space = space_id(H5Aget_space(attr), "H5Aget_space");
+    return shape_of(type, space);
+}
+
 double read_double_attribute(hid_t obj, const std::string& name)
 {
+    const Id attr = open_scalar(obj, name, {TypeClass::floating, TypeClass::integer}, "a number");
     double v = 0;
-    check(H5Aread(open_attribute(obj, name), H5T_NATIVE_DOUBLE, &v), "H5Aread " + name);
+    check(H5Aread(attr, H5T_NATIVE_DOUBLE, &v), "H5Aread " + name);
     return v;
 }
 
 std::int64_t read_int_attribute(hid_t obj, const std::string& name)
 {
+    const Id attr = open_scalar(obj, name, {TypeClass::integer}, "an integer");
     std::int64_t v = 0;
-    check(H5Aread(open_attribute(obj, name), H5T_NATIVE_INT64, &v), "H5Aread " + name);
+    check(H5Aread(attr, H5T_NATIVE_INT64, &v), "H5Aread " + name);
     return v;
 }
 
 std::string read_string_attribute(hid_t obj, const std::string& name)
 {
-    const Id attr = open_attribute(obj, name);
+    const Id attr = open_scalar(obj, name, {TypeClass::string}, "a text");
     const Id file_type = type_id(H5Aget_type(attr), "H5Aget_type");
-    if (H5Tget_class(file_type) != H5T_STRING) throw Error("HDF5: attribute " + name + " is not a string");
     if (H5Tis_variable_str(file_type) > 0) {
         const Id type = variable_string_type();
         char* p = nullptr;
@@ -122,9 +311,11 @@ std::string read_string_attribute(hid_t obj, const std::string& name)
 std::vector<std::uint64_t> read_u64_vector_attribute(hid_t obj, const std::string& name)
 {
     const Id attr = open_attribute(obj, name);
+    const Id type = type_id(H5Aget_type(attr), "H5Aget_type");
     const Id space = space_id(H5Aget_space(attr), "H5Aget_space");
-    const hssize_t n = check(H5Sget_simple_extent_npoints(space), "H5Sget_simple_extent_npoints");
-    std::vector<std::uint64_t> v(static_cast<std::size_t>(n));
+    const Shape s = shape_of(type, space);
+    if (s.type != TypeClass::integer) throw Error("attribute " + name + " is not a list of integers");
+    std::vector<std::uint64_t> v(s.elements());
     check(H5Aread(attr, H5T_NATIVE_UINT64, v.data()), "H5Aread " + name);
     return v;
 }
@@ -132,26 +323,54 @@ std::vector<std::uint64_t> read_u64_vector_attribute(hid_t obj, const std::strin
 std::vector<std::string> read_string_vector_attribute(hid_t obj, const std::string& name)
 {
     const Id attr = open_attribute(obj, name);
+    const Id file_type = type_id(H5Aget_type(attr), "H5Aget_type");
     const Id space = space_id(H5Aget_space(attr), "H5Aget_space");
-    const auto n = static_cast<std::size_t>(check(H5Sget_simple_extent_npoints(space), "H5Sget_simple_extent_npoints"));
-    const Id type = variable_string_type();
-    std::vector<char*> p(n, nullptr);
-    check(H5Aread(attr, type, p.data()), "H5Aread " + name);
+    const Shape s = shape_of(file_type, space);
+    if (s.type != TypeClass::string) throw Error("attribute " + name + " is not a list of texts");
+    const auto n = static_cast<std::size_t>(s.elements());
     std::vector<std::string> out;
-    for (char* s : p) {
-        out.emplace_back(s ? s : "");
-        H5free_memory(s);
+    if (H5Tis_variable_str(file_type) > 0) {
+        const Id type = variable_string_type();
+        std::vector<char*> p(n, nullptr);
+        check(H5Aread(attr, type, p.data()), "H5Aread " + name);
+        for (char* c : p) {
+            out.emplace_back(c ? c : "");
+            H5free_memory(c);
+        }
+        return out;
+    }
+    const std::size_t size = H5Tget_size(file_type);
+    std::string buf(n * size, '\0');
+    check(H5Aread(attr, file_type, buf.data()), "H5Aread " + name);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::string item = buf.substr(i * size, size);
+        out.push_back(item.substr(0, item.find('\0')));
     }
     return out;
 }
 
-std::vector<hsize_t> dataset_shape(hid_t dataset)
+// ---------------------------------------------------------------------- dimension scales
+
+void make_dimension_scale(hid_t dataset, const std::string& name)
 {
-    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space");
-    const int rank = check(H5Sget_simple_extent_ndims(space), "H5Sget_simple_extent_ndims");
-    std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-    check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), "H5Sget_simple_extent_dims");
-    return dims;
+    check(H5DSset_scale(dataset, name.c_str()), "H5DSset_scale " + name);
+}
+
+void attach_dimension_scale(hid_t data, hid_t scale, unsigned dim)
+{
+    check(H5DSattach_scale(data, scale, dim), "H5DSattach_scale");
+}
+
+// --------------------------------------------------------------------------- selections
+
+void select_box(hid_t space, const std::vector<hsize_t>& start, const std::vector<hsize_t>& count, H5S_seloper_t op)
+{
+    check(H5Sselect_hyperslab(space, op, start.data(), nullptr, count.data(), nullptr), "H5Sselect_hyperslab");
+}
+
+Id simple_space(const std::vector<hsize_t>& dims)
+{
+    return space_id(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), "H5Screate_simple");
 }
 
 }  // namespace superball::h5

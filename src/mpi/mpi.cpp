@@ -13,12 +13,30 @@ void check(int code, const char* what)
 
 Environment::Environment()
 {
-    // Only `explore` starts MPI, so the command-line arguments are not MPI's business.
-    check(MPI_Init(nullptr, nullptr), "MPI_Init");
+    // The command-line arguments are not MPI's business. FUNNELED: the run's writer threads
+    // (io/posix_file.hpp) make no MPI call, only the main thread does.
+    int provided = MPI_THREAD_SINGLE;
+    check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+    if (provided < MPI_THREAD_FUNNELED) {
+        MPI_Finalize();
+        throw std::runtime_error("MPI_Init_thread: this MPI library cannot run a process with threads (MPI_THREAD_FUNNELED)");
+    }
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
 }
 
 Environment::~Environment() { MPI_Finalize(); }
+
+Info::Info() { check(MPI_Info_create(&info_), "MPI_Info_create"); }
+
+Info::~Info()
+{
+    if (info_ != MPI_INFO_NULL) MPI_Info_free(&info_);
+}
+
+void Info::set(const std::string& key, const std::string& value)
+{
+    check(MPI_Info_set(info_, key.c_str(), value.c_str()), "MPI_Info_set");
+}
 
 int Comm::rank() const
 {

@@ -11,6 +11,12 @@
 
 namespace superball::mpi {
 
+// A failure that every rank of a communicator raises alike, so the ranks are still in step:
+// the caller reports it once and exits normally (no MPI_Abort).
+struct CollectiveError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 // Turns an MPI error code into an exception (MPI_ERRORS_RETURN is set on the world
 // communicator by Environment).
 void check(int code, const char* what);
@@ -22,6 +28,20 @@ public:
     ~Environment();
     Environment(const Environment&) = delete;
     Environment& operator=(const Environment&) = delete;
+};
+
+// An MPI_Info object of hints (MPI-IO's, here), freed with the object.
+class Info {
+public:
+    Info();
+    ~Info();
+    Info(const Info&) = delete;
+    Info& operator=(const Info&) = delete;
+    void set(const std::string& key, const std::string& value);
+    MPI_Info get() const { return info_; }
+
+private:
+    MPI_Info info_ = MPI_INFO_NULL;
 };
 
 // A communicator borrowed from MPI (not freed here).

@@ -27,7 +27,7 @@ std::vector<std::uint64_t> pack(bool stop, const std::vector<TileReport>& report
 
 void worker(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work, const StopRequested& stop)
 {
-    const Serve nothing = [] {};
+    const Serve nothing;
     std::vector<TileReport> reports;
     for (;;) {
         const std::vector<std::uint64_t> msg = pack(stop(), reports);
@@ -142,12 +142,12 @@ ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const std::uint64_t
     std::int64_t interrupted = 0;
     if (comm.is_root()) {
         Master master(comm, pending.size(), done, stop, settings.granule);
-        const Serve serve = [&master] { master.serve(); };
+        const Serve serve = comm.size() > 1 ? Serve([&master] { master.serve(); }) : Serve();
         while (master.has_work()) {
             const auto [first, count] = master.take();
             for (std::uint64_t i = first; i < first + count; ++i) {
                 work.compute(pending[i], serve);
-                master.serve();
+                if (serve) master.serve();
                 if (stop()) break;
             }
             const std::vector<TileReport> reports = work.flush();
