@@ -17,7 +17,7 @@ constexpr double easy_fraction = 0.25;
 constexpr double growth = 1.5;
 
 struct Plane {
-    const Model& model;
+    Model model;  // the other coefficients
     Parameter first, second;
 };
 
