@@ -12,8 +12,6 @@ import csv
 import io
 import math
 import os
-import shutil
-import subprocess
 import sys
 import textwrap
 from typing import NamedTuple
@@ -24,12 +22,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from superball_results import (  # noqa: E402  (needs the path above)
     AXIS_LABELS,
-    EXIT_FAILURE,
     ScriptError,
     new_figure,
     parse_size,
     pyplot,
     run_script,
+    run_superball,
 )
 
 # Columns after the parameter's, in the order `superball continue` writes them.
@@ -328,25 +326,10 @@ def draw_curves(diagram, size, png, pdf):
     return lines
 
 
-def run_superball(arguments):
-    """CSV text of `superball continue ARGS --format csv`."""
-    binary = os.environ.get("SUPERBALL") or shutil.which("superball")
-    if not binary:
-        raise ScriptError("cannot find the superball binary: set SUPERBALL or put superball on PATH", EXIT_FAILURE)
-    if arguments and arguments[0] == "continue":
-        arguments = arguments[1:]
-    command = [binary, "continue"] + arguments + ["--format", "csv"]
-    process = subprocess.run(command, capture_output=True, text=True)
-    if process.returncode != 0:
-        status = process.returncode if process.returncode in (1, 2) else EXIT_FAILURE
-        raise ScriptError(f"{' '.join(command)} failed: {process.stderr.strip()}", status)
-    return process.stdout
-
-
 def load(args):
     """The diagram and a name for it (for the default output)."""
     if args.run is not None:
-        return read_csv(run_superball(args.run), "superball continue"), None
+        return read_csv(run_superball("continue", args.run + ["--format", "csv"]), "superball continue"), None
     if args.input == "-":
         return read_csv(sys.stdin.read(), "standard input"), None
     if not os.path.isfile(args.input):

@@ -401,21 +401,15 @@ int run(const ContinueOptions& opt)
     }
     if (!world.is_root()) return 0;
 
-    std::FILE* f = stdout;
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
-    if (!opt.output.empty()) {
-        file.reset(std::fopen(opt.output.c_str(), "w"));
-        if (!file) throw std::runtime_error("cannot write " + opt.output);
-        f = file.get();
-    }
-    if (opt.format == "json") {
-        write_json(f, result, cont, world.size());
-    } else if (cont.curves) {
-        write_curves_csv(f, result, cont, world.size());
-    } else {
-        write_csv(f, result, cont, world.size());
-    }
-    if (file && std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + opt.output);
+    write_output(opt.output, [&](std::FILE* f) {
+        if (opt.format == "json") {
+            write_json(f, result, cont, world.size());
+        } else if (cont.curves) {
+            write_curves_csv(f, result, cont, world.size());
+        } else {
+            write_csv(f, result, cont, world.size());
+        }
+    });
     return 0;
 }
 

@@ -170,22 +170,17 @@ std::optional<Vector4> tangent(const System& sys, const Eigen::Matrix<double, 3,
     return Vector4(z / n);
 }
 
-// Newton's method on H(y) = 0 with the linear condition normal . y = level, from y. The
-// tangent of the solution is oriented along `orientation`.
-std::optional<Node> correct(const System& sys, Vector4 y, const Vector4& normal, double level,
-                            const Vector4& orientation, int iterations = corrector_iterations)
+// Newton's method on H(y) = 0 and one more equation, from y; step(evaluation, y) is the
+// Newton step. The converged point (residual within accepted_residual) carries its tangent,
+// oriented along `orientation`.
+template <class Step>
+std::optional<Node> newton(const System& sys, Vector4 y, const Vector4& orientation, int iterations, const Step& step)
 {
     for (int it = 1; it <= iterations; ++it) {
         if (sys.corner) y(0) = 0.0;
         const auto ev = evaluate(sys, y);
         if (!ev) return std::nullopt;
-        Eigen::Matrix4d a;
-        a.topRows<3>() = ev->J;
-        a.row(3) = normal.transpose();
-        Vector4 r;
-        r.head<3>() = ev->H;
-        r(3) = normal.dot(y) - level;
-        const Vector4 d = a.fullPivLu().solve(-r);
+        const Vector4 d = step(*ev, y);
         if (!d.allFinite()) return std::nullopt;
         y += d;
         if (sys.corner) y(0) = 0.0;
@@ -200,36 +195,39 @@ std::optional<Node> correct(const System& sys, Vector4 y, const Vector4& normal,
     return std::nullopt;
 }
 
+// Newton's method on H(y) = 0 with the linear condition normal . y = level, from y.
+std::optional<Node> correct(const System& sys, const Vector4& y, const Vector4& normal, double level,
+                            const Vector4& orientation, int iterations = corrector_iterations)
+{
+    return newton(sys, y, orientation, iterations, [&](const Evaluation& ev, const Vector4& at) {
+        Eigen::Matrix4d a;
+        a.topRows<3>() = ev.J;
+        a.row(3) = normal.transpose();
+        Vector4 r;
+        r.head<3>() = ev.H;
+        r(3) = normal.dot(at) - level;
+        return Vector4(a.fullPivLu().solve(-r));
+    });
+}
+
 // The predictor-corrector step of arclength h from `a`.
 std::optional<Node> step(const System& sys, const Node& a, double h, int iterations = corrector_iterations)
 {
     return correct(sys, a.y + h * a.t, a.t, a.t.dot(a.y) + h, a.t, iterations);
 }
 
-// Natural-parameter Newton at p = value from y.
+// Natural-parameter Newton at p = value from y. Full pivoting: where H_x is singular to
+// rounding (a family of cycles at fixed p, a fold on the bound) the step leaves the free
+// direction alone.
 std::optional<Node> solve_at_parameter(const System& sys, Vector4 y, double value, const Vector4& orientation)
 {
     y(3) = value;
-    for (int it = 1; it <= corrector_iterations; ++it) {
-        if (sys.corner) y(0) = 0.0;
-        const auto ev = evaluate(sys, y);
-        if (!ev) return std::nullopt;
-        // Full pivoting: where H_x is singular to rounding (a family of cycles at fixed p, a
-        // fold on the bound) the step leaves the free direction alone.
-        const Eigen::Matrix3d hx = ev->J.leftCols<3>();
-        const Eigen::Vector3d d = -hx.fullPivLu().solve(ev->H);
-        if (!d.allFinite()) return std::nullopt;
-        y.head<3>() += d;
-        if (d.norm() <= corrector_tolerance * (1.0 + y.norm())) {
-            if (sys.corner) y(0) = 0.0;
-            auto last = evaluate(sys, y);
-            if (!last || last->H.cwiseAbs().maxCoeff() > accepted_residual) return std::nullopt;
-            const auto t = tangent(sys, last->J, orientation);
-            if (!t) return std::nullopt;
-            return Node{y, *t, std::move(*last), it};
-        }
-    }
-    return std::nullopt;
+    return newton(sys, y, orientation, corrector_iterations, [](const Evaluation& ev, const Vector4&) {
+        const Eigen::Matrix3d hx = ev.J.leftCols<3>();
+        Vector4 d = Vector4::Zero();
+        d.head<3>() = -hx.fullPivLu().solve(ev.H);
+        return d;
+    });
 }
 
 // ---- Test functions ---------------------------------------------------------------------

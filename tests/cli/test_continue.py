@@ -7,7 +7,7 @@ branch crosses, and the elastic ball's self-retracing fixed points; CSV against 
 same output under mpirun -n 1 and -n 2, and bad input.
 
 Run by ctest as `$SUPERBALL_PYTHON tests/cli/test_continue.py -v` with
-  SUPERBALL  the built binary
+  SUPERBALL  the built binary (default: a build of this repository, tests/superball_testing.py)
   MPIEXEC    mpirun (default: mpirun on PATH)
 Needs numpy (eigenvalues).
 """
@@ -19,11 +19,14 @@ import json
 import math
 import os
 import subprocess
+import sys
 import unittest
 
 import numpy as np
 
-SUPERBALL = os.environ.get("SUPERBALL", "")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import mpi_env, superball_binary  # noqa: E402
+
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
 # e = 0.9, alpha = 0.99: the interior fixed point and the corner fixed point, continued in alpha.
@@ -42,23 +45,11 @@ COLUMNS = ["branch", "period", "corner", "alpha", "xi", "U", "W", "lambda", "ev1
 EVENTS = {"", "fold", "period_doubling", "neimark_sacker", "branch_point", "boundary", "end"}
 
 
-def setUpModule():
-    if not SUPERBALL or not os.access(SUPERBALL, os.X_OK):
-        raise RuntimeError("set SUPERBALL to the built superball binary (got %r)" % SUPERBALL)
-
-
-def mpi_env():
-    env = dict(os.environ)
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-    env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    env.setdefault("OMPI_MCA_rmaps_base_oversubscribe", "1")
-    return env
-
-
 def run(*args, ranks=0, timeout=120):
-    """`superball ARGS`, under `mpirun -n RANKS` if ranks > 0."""
+    """`superball ARGS`, under `mpirun -n RANKS --oversubscribe` if ranks > 0."""
     prefix = [MPIEXEC, "-n", str(ranks), "--oversubscribe"] if ranks else []
-    return subprocess.run([*prefix, SUPERBALL, *args], capture_output=True, text=True, env=mpi_env(), timeout=timeout)
+    return subprocess.run([*prefix, superball_binary(), *args], capture_output=True, text=True, env=mpi_env(),
+                          timeout=timeout)
 
 
 def continued(*args, ranks=0, fmt="json"):
