@@ -59,6 +59,7 @@ void print_summary(const Job& job, const RunSummary& r, const KernelVariant& ker
     } else if (r.complete) {
         fmt::print(stderr, "result: {}\n", r.output.string());
     }
+    if (!r.sidecar_note.empty()) fmt::print(stderr, "{}\n", r.sidecar_note);
     if (job.refine != 0) {
         fmt::print(stderr, "refinement: {} of {} points counted ({:.1f}%), the others filled from agreeing corners\n",
                    r.points_counted, n, 100.0 * static_cast<double>(r.points_counted) / static_cast<double>(std::max<std::uint64_t>(n, 1)));

@@ -165,9 +165,16 @@ FinishReport write_result(const fs::path& partial, const fs::path& output, const
             failed = 1;
             why = fmt::format("renaming {} to {} failed ({})", tmp.string(), output.string(), ec.message());
         } else {
-            write_xdmf(output);
             fs::remove(partial, ec);
             report.file_bytes = size_of(output);
+            // The result is complete whatever happens to its sidecar: a failure here is a
+            // note, and must not leave the other ranks waiting below.
+            try {
+                const fs::path xmf = write_xdmf(output);
+                report.sidecar_note = xmf.empty() ? "no XDMF sidecar: " + xdmf_unsupported(output) : "sidecar: " + xmf.string();
+            } catch (const std::exception& e) {
+                report.sidecar_note = std::string("no XDMF sidecar: writing it failed (") + e.what() + ")";
+            }
         }
     }
     if (comm.broadcast(failed) != 0) {
@@ -177,6 +184,7 @@ FinishReport write_result(const fs::path& partial, const fs::path& output, const
     report.raw_bytes = count_bytes + 1;
     for (const std::uint64_t n : shape) report.raw_bytes *= n;
     report.file_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(report.file_bytes)));
+    comm.broadcast(report.sidecar_note);
     report.seconds = comm.broadcast(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
     return report;
 }

@@ -24,6 +24,11 @@ SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
 
+def text(value):
+    """An HDF5 text attribute as str (h5py gives fixed-length ones as bytes)."""
+    return value.decode("ascii") if isinstance(value, bytes) else str(value)
+
+
 def job_text(grid, model="e = 0.9\nalpha = 0.9", run="max_bounces = 1000"):
     return f"[model]\n{model}\n\n[grid]\n{grid}\n\n[run]\n{run}\n"
 
@@ -115,7 +120,7 @@ class Explore(unittest.TestCase):
             self.assertEqual(sorted(f), ["U", "W", "outcome", "wall_bounces", "xi"])
             for d in (counts, outcome):
                 self.assertEqual([dim[0].name for dim in d.dims], ["/xi", "/W"])
-                self.assertEqual(d.attrs["coordinates"], "U")
+                self.assertEqual(text(d.attrs["coordinates"]), "U")
             self.assertTrue(h5py.h5ds.is_scale(f["xi"].id))
             # Cell centres, computed as SPEC.md section 4 says.
             expect = np.array([0.0 + (i + 0.5) * (1.0 - 0.0) / 61 for i in range(61)])
@@ -123,15 +128,17 @@ class Explore(unittest.TestCase):
             self.assertEqual(f["W"].dtype, np.float64)
             self.assertEqual(f["U"][()], -1.0)
             for name in ("xi", "U", "W"):
-                self.assertEqual(f[name].attrs["units"], "1")
-                self.assertIn(name, f[name].attrs["long_name"])
-            self.assertEqual(counts.attrs["units"], "1")
-            self.assertTrue(counts.attrs["long_name"])
+                self.assertEqual(text(f[name].attrs["units"]), "1")
+                self.assertIn(name, text(f[name].attrs["long_name"]))
+            self.assertEqual(text(counts.attrs["units"]), "1")
+            self.assertTrue(text(counts.attrs["long_name"]))
             self.assertEqual(list(outcome.attrs["flag_values"]), [0, 1, 2, 3])
             self.assertEqual(outcome.attrs["flag_values"].dtype, np.uint8)
-            self.assertEqual(outcome.attrs["flag_meanings"], "invalid left missed capped")
+            self.assertEqual(text(outcome.attrs["flag_meanings"]), "invalid left missed capped")
+            # netCDF text (fixed-length ASCII), not NC_STRING, which some netCDF tools drop.
+            self.assertFalse(h5py.check_string_dtype(outcome.attrs.get_id("flag_meanings").dtype).length is None)
             a = f.attrs
-            self.assertEqual(a["Conventions"], "CF-1.8")
+            self.assertEqual(text(a["Conventions"]), "CF-1.8")
             self.assertEqual(a["coordinate_system"], "canonical")
             self.assertNotIn("coordinates", a)  # CF's keyword for auxiliary coordinates: xarray would take it
             self.assertEqual(list(a["axis_names"]), ["xi", "W"])
@@ -221,7 +228,7 @@ class Explore(unittest.TestCase):
             wb, oc = f["wall_bounces"][()], f["outcome"][()]
             u = f["u"][()]
             self.assertEqual(f.attrs["coordinate_system"], "physical")
-            self.assertEqual([f[n].attrs["units"] for n in ("x", "u", "v", "omega")], ["m", "m/s", "m/s", "rad/s"])
+            self.assertEqual([text(f[n].attrs["units"]) for n in ("x", "u", "v", "omega")], ["m", "m/s", "m/s", "rad/s"])
             self.assertEqual(f.attrs["g"], 9.81)
             self.assertEqual(f.attrs["radius"], 0.025)
             self.assertEqual(f.attrs["fixed_v"], 2.0)
