@@ -197,7 +197,6 @@ def main():
     native = Builds(a.native) if a.native != "none" else None
     min_time = 0.3 if a.quick else 1.0
     kernels = runnable_kernels(portable)
-    vectorised = [k for k in kernels if k != "scalar"]
     best = portable.kernel
 
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
@@ -209,7 +208,8 @@ def main():
 
     r = {key: [] for key in ("kernel", "native_kernel", "n1", "n2", "p8192", "n8192", "tile1024", "tile262144",
                              "calls", "single", "single_before", "mpirun", "mpirun_before", "n2_16384",
-                             "refine_slice", "refine_volume")}
+                             "refine_slice", "refine_volume", "full_slice", "coarse_slice", "full_volume",
+                             "coarse_volume")}
     mismatch = {}
     with tempfile.TemporaryDirectory(prefix="superball-bench-") as d:
         ex = Explorer(d)
@@ -225,34 +225,41 @@ def main():
                        for name, text in (("slice", slice_text), ("volume", volume_text)) for refine in (0, 8)}
         for rep in range(a.repetitions):
             print(f"repetition {rep + 1} of {a.repetitions}", file=sys.stderr, flush=True)
-            r["kernel"].append(kernel_rates(portable, 4096, kernels, min_time))
+            # Each pair runs A B in even repetitions and B A in odd ones: neither always
+            # follows the other (the page cache's writeback of one run's output slows the next).
+            def pair(key_a, run_a, key_b, run_b):
+                for key, run in ((key_a, run_a), (key_b, run_b)) if rep % 2 == 0 else ((key_b, run_b), (key_a, run_a)):
+                    r[key].append(run())
+
             if native:
-                r["native_kernel"].append(kernel_rates(native, 4096, [native.kernel], min_time)[native.kernel])
-            r["n1"].append(ex.run(portable, slice_4096, 1))
-            r["n2"].append(ex.run(portable, slice_4096, 2))
+                pair("kernel", lambda: kernel_rates(portable, 4096, kernels, min_time),
+                     "native_kernel", lambda: kernel_rates(native, 4096, [native.kernel], min_time)[native.kernel])
+            else:
+                r["kernel"].append(kernel_rates(portable, 4096, kernels, min_time))
+            pair("n1", lambda: ex.run(portable, slice_4096, 1), "n2", lambda: ex.run(portable, slice_4096, 2))
             # Issue 14: the portable binary against the native build, one rank, 8192^2.
-            r["p8192"].append(ex.run(portable, slice_8192, 1))
             if native:
-                r["n8192"].append(ex.run(native, slice_8192, 1))
+                pair("p8192", lambda: ex.run(portable, slice_8192, 1), "n8192", lambda: ex.run(native, slice_8192, 1))
             # Issue 12: cost of a tile beyond its points, one rank.
-            r["tile1024"].append(ex.run(portable, tiles_1024, 1))
-            r["tile262144"].append(ex.run(portable, tiles_262144, 1))
+            pair("tile1024", lambda: ex.run(portable, tiles_1024, 1), "tile262144",
+                 lambda: ex.run(portable, tiles_262144, 1))
             r["calls"].append(write_calls(ex, portable, slice_8192, 2, "calls-8192.h5"))
             # Start-up of a 64^2 job: superball's choice on one node (ob1; no daemon for a
             # singleton) and Open MPI's own (the parameters set by hand, to nothing and to
             # its default, which superball leaves alone).
             own = without_kernel_choice(OMPI_MCA_pml="", OMPI_MCA_ess_singleton_isolated="0")
             for _ in range(2):
-                r["single"].append(ex.run(portable, slice_64, 1, singleton=True)["wall"])
-                r["single_before"].append(ex.run(portable, slice_64, 1, singleton=True, env=own)["wall"])
-                r["mpirun"].append(ex.run(portable, slice_64, 2)["wall"])
-                r["mpirun_before"].append(ex.run(portable, slice_64, 2, env=own)["wall"])
+                pair("single", lambda: ex.run(portable, slice_64, 1, singleton=True)["wall"],
+                     "single_before", lambda: ex.run(portable, slice_64, 1, singleton=True, env=own)["wall"])
+                pair("mpirun", lambda: ex.run(portable, slice_64, 2)["wall"],
+                     "mpirun_before", lambda: ex.run(portable, slice_64, 2, env=own)["wall"])
             if not (a.quick or a.skip_16384):
                 r["n2_16384"].append(ex.run(portable, os.path.join(HERE, "slice_16384.toml"), 2))
             if not a.quick:
                 for name in ("slice", "volume"):
-                    full = ex.run(portable, refine_jobs[(name, 0)], 2, keep=f"{name}-0.h5")
-                    coarse = ex.run(portable, refine_jobs[(name, 8)], 2, keep=f"{name}-8.h5")
+                    pair(f"full_{name}", lambda: ex.run(portable, refine_jobs[(name, 0)], 2, keep=f"{name}-0.h5"),
+                         f"coarse_{name}", lambda: ex.run(portable, refine_jobs[(name, 8)], 2, keep=f"{name}-8.h5"))
+                    full, coarse = r[f"full_{name}"][-1], r[f"coarse_{name}"][-1]
                     r[f"refine_{name}"].append(coarse["rate"] / full["rate"])
                     mismatch[name] = refinement_mismatch(full["output"], coarse["output"])
                     remove_outputs(full["output"])
