@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import superball_binary  # noqa: E402
+from superball_testing import superball_binary, wall_impacts_per_second  # noqa: E402
 
 SOURCE = os.path.abspath(os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", ".."))
 CLUSTER = os.path.join(SOURCE, "tests", "jobs", "slurm_cluster.sh")
@@ -45,25 +45,31 @@ output = "out/tiny.h5"
 """
 
 # Garwin's ball (e = alpha = 1) in a corner of launches that mostly never leave: nearly every
-# point costs max_bounces iterations: about 4 CPU-seconds, spread over 64 short tiles (a stop
-# request is honoured within a fraction of a second).
-SLOW_JOB = """\
+# point costs max_bounces iterations, set from the binary's measured speed
+# (wall_impacts_per_second) so that two ranks take about `seconds`, spread over 64 tiles of a
+# fraction of a second each (a stop request is honoured quickly). A fixed max_bounces made the
+# job last 4 s with one kernel and 0.5 s with the AVX-512 one, too short to be stopped twice.
+def slow_job(speed, seconds=5.0):
+    points = 256 * 256
+    max_bounces = max(1000, int(2 * seconds * speed / points))
+    return f"""\
 [model]
 e = 1.0
 alpha = 1.0
 
 [grid]
 coordinates = "canonical"
-xi = { min = 0.0, max = 0.1, n = 256 }
+xi = {{ min = 0.0, max = 0.1, n = 256 }}
 U = -0.3
-W = { min = -3.0, max = -2.5, n = 64 }
+W = {{ min = -3.0, max = -2.5, n = 256 }}
 
 [run]
-max_bounces = 12000
-tile_points = 256
+max_bounces = {max_bounces}
+tile_points = 1024
 checkpoint_seconds = 0.2
 output = "out/slow.h5"
 """
+
 
 cluster_env = {}
 started_here = False
@@ -203,7 +209,7 @@ class SlurmExplore(unittest.TestCase):
         self.assertGreater(len(np.unique(data["wall_bounces"])), 3)
 
     def test_stopped_job_resumes_on_resubmission(self):
-        self.write("slow.toml", SLOW_JOB)
+        self.write("slow.toml", slow_job(wall_impacts_per_second(superball_binary(), self.tmp)))
         out = os.path.join(self.tmp, "out", "slow.h5")
 
         # Stopped the way the time limit does it (--signal=B:TERM: only the batch shell is
