@@ -123,9 +123,16 @@ Shape shape_of(hid_t type, hid_t space)
         case H5T_INTEGER:
             s.type = TypeClass::integer;
             s.is_signed = H5Tget_sign(type) == H5T_SGN_2;
+            s.little_endian = H5Tget_order(type) == H5T_ORDER_LE;
             break;
-        case H5T_FLOAT: s.type = TypeClass::floating; break;
-        case H5T_STRING: s.type = TypeClass::string; break;
+        case H5T_FLOAT:
+            s.type = TypeClass::floating;
+            s.little_endian = H5Tget_order(type) == H5T_ORDER_LE;
+            break;
+        case H5T_STRING:
+            s.type = TypeClass::string;
+            s.variable_length = H5Tis_variable_str(type) > 0;
+            break;
         default: s.type = TypeClass::other; break;
     }
     s.bytes = H5Tget_size(type);
@@ -157,6 +164,40 @@ std::vector<hsize_t> dataset_shape(hid_t dataset)
     std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
     check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), "H5Sget_simple_extent_dims");
     return dims;
+}
+
+Storage dataset_storage(hid_t dataset)
+{
+    Storage st;
+    const Id dcpl = plist_id(H5Dget_create_plist(dataset), "H5Dget_create_plist");
+    const Shape s = dataset_shape_of(dataset);
+    const H5D_layout_t layout = H5Pget_layout(dcpl);
+    if (layout == H5D_CHUNKED) {
+        st.chunk.resize(s.dims.size());
+        const int rank = check(H5Pget_chunk(dcpl, static_cast<int>(st.chunk.size()), st.chunk.data()), "H5Pget_chunk");
+        if (static_cast<std::size_t>(rank) != s.dims.size()) throw Error("HDF5: the chunks' rank differs from the dataset's");
+        st.filters = check(H5Pget_nfilters(dcpl), "H5Pget_nfilters");
+        // Chunks expected: the grid of chunks over the extent.
+        hsize_t expected = 1;
+        for (std::size_t k = 0; k < s.dims.size(); ++k) {
+            if (st.chunk[k] == 0) throw Error("HDF5: a chunk dimension is 0");
+            expected *= (s.dims[k] + st.chunk[k] - 1) / st.chunk[k];
+        }
+        const Id space = space_id(H5Dget_space(dataset), "H5Dget_space");
+        hsize_t chunks = 0;
+        check(H5Dget_num_chunks(dataset, space, &chunks), "H5Dget_num_chunks");
+        st.allocated = chunks == expected;
+    } else if (layout == H5D_CONTIGUOUS || layout == H5D_COMPACT) {
+        st.allocated = H5Dget_storage_size(dataset) == s.elements() * s.bytes;
+    }
+    return st;
+}
+
+haddr_t object_address(hid_t object)
+{
+    H5O_info_t info{};
+    check(H5Oget_info2(object, &info, H5O_INFO_BASIC), "H5Oget_info");
+    return info.addr;
 }
 
 std::uint64_t contiguous_offset(hid_t dataset)
@@ -359,6 +400,34 @@ void make_dimension_scale(hid_t dataset, const std::string& name)
 void attach_dimension_scale(hid_t data, hid_t scale, unsigned dim)
 {
     check(H5DSattach_scale(data, scale, dim), "H5DSattach_scale");
+}
+
+std::vector<std::vector<haddr_t>> attached_scales(hid_t data)
+{
+    static constexpr const char* name = "DIMENSION_LIST";
+    if (!has_attribute(data, name)) return {};
+    const Id attr = open_attribute(data, name);
+    const Id type = type_id(H5Aget_type(attr), "H5Aget_type");
+    const Id space = space_id(H5Aget_space(attr), "H5Aget_space");
+    const int rank = check(H5Sget_simple_extent_ndims(space), "H5Sget_simple_extent_ndims");
+    const Id base = H5Tget_class(type) == H5T_VLEN ? type_id(H5Tget_super(type), "H5Tget_super") : Id{};
+    if (H5Sget_simple_extent_type(space) != H5S_SIMPLE || rank != 1 || !base.valid() ||
+        H5Tequal(base, H5T_STD_REF_OBJ) <= 0) {
+        throw Error("attribute DIMENSION_LIST is not a list of object references per dimension");
+    }
+    hsize_t n = 0;
+    check(H5Sget_simple_extent_dims(space, &n, nullptr), "H5Sget_simple_extent_dims");
+    if (n > 32) throw Error("attribute DIMENSION_LIST lists more than 32 dimensions");
+    const Id memory = type_id(H5Tvlen_create(H5T_STD_REF_OBJ), "H5Tvlen_create");
+    std::vector<hvl_t> lists(n, hvl_t{0, nullptr});
+    check(H5Aread(attr, memory, lists.data()), "H5Aread DIMENSION_LIST");
+    std::vector<std::vector<haddr_t>> out(n);
+    for (hsize_t k = 0; k < n; ++k) {
+        const auto* refs = static_cast<const hobj_ref_t*>(lists[k].p);
+        if (refs != nullptr) out[k].assign(refs, refs + lists[k].len);
+    }
+    check(H5Dvlen_reclaim(memory, space, H5P_DEFAULT, lists.data()), "H5Dvlen_reclaim");
+    return out;
 }
 
 // --------------------------------------------------------------------------- selections
