@@ -129,3 +129,38 @@ def interrupted_run(binary, job, out, reference, done):
         f["progress/tile_checksum"][...] = sums
         f["progress/tile_done"][...] = flags
     return partial
+
+
+# Small jobs of every kind of result the outside clients (xarray, netCDF tools, ParaView)
+# must read: grids of a few thousand points, each run in well under a second. The axes
+# have different lengths, so that a transposed reading cannot pass.
+CLIENT_JOBS = {
+    "slice": ("[model]\ne = 0.9\nalpha = 0.9\n\n[grid]\n"
+              "xi = { min = 0.0, max = 1.0, n = 40 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 30 }\n"),
+    "volume": ("[model]\ne = 0.9\nalpha = 0.9\n\n[grid]\n"
+               "xi = { min = 0.0, max = 1.0, n = 20 }\nU = { min = -3.0, max = -0.2, n = 12 }\n"
+               "W = { min = -3.0, max = 3.0, n = 16 }\n"),
+    "physical": ("[model]\ne = 0.9\nalpha = 0.9\ng = 9.81\nradius = 0.025\n\n[grid]\ncoordinates = \"physical\"\n"
+                 "x = { min = 0.0, max = 0.2, n = 30 }\nu = { min = -3.0, max = 1.0, n = 20 }\nv = 2.0\nomega = -200.0\n"),
+    "swept": ("[model]\ne = 0.9\nalpha = { min = 0.5, max = 1.0, n = 5 }\ne_floor = 0.8\n\n[grid]\n"
+              "xi = { min = 0.0, max = 1.0, n = 40 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 30 }\n"),
+}
+
+
+def client_results(directory, kinds, names=None):
+    """Results of CLIENT_JOBS[kind] for each of `kinds`, computed by the binary under test
+    with two ranks in `directory`; `names` maps a kind to its output's file name (default
+    KIND.h5). Returns {kind: absolute path of the result}."""
+    binary = superball_binary()
+    mpiexec = os.environ.get("MPIEXEC") or "mpirun"
+    paths = {}
+    for kind in kinds:
+        name = (names or {}).get(kind, kind + ".h5")
+        job, out = os.path.join(directory, kind + ".toml"), os.path.abspath(os.path.join(directory, name))
+        with open(job, "w") as f:
+            f.write(CLIENT_JOBS[kind] + "\n[run]\nmax_bounces = 1000\n")
+        cmd = [mpiexec, "-n", "2", "--oversubscribe", binary, "explore", job, "-o", out, "-q"]
+        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=300)
+        assert r.returncode == 0, f"{' '.join(cmd)}\n{r.stderr}"
+        paths[kind] = out
+    return paths

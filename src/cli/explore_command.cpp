@@ -54,17 +54,19 @@ void print_summary(const Job& job, const RunSummary& r)
                    r.output.string(), static_cast<double>(r.result_bytes) / 1e6,
                    100.0 * static_cast<double>(r.result_bytes) / static_cast<double>(r.raw_bytes),
                    static_cast<double>(r.raw_bytes) / 1e6, r.finish_seconds);
-    } else {
+    } else if (r.complete) {
         fmt::print(stderr, "result: {}\n", r.output.string());
     }
+    if (!r.sidecar_note.empty()) fmt::print(stderr, "{}\n", r.sidecar_note);
     if (job.refine != 0) {
         fmt::print(stderr, "refinement: {} of {} points counted ({:.1f}%), the others filled from agreeing corners\n",
                    r.points_counted, n, 100.0 * static_cast<double>(r.points_counted) / static_cast<double>(std::max<std::uint64_t>(n, 1)));
     }
     if (r.interrupted) {
-        fmt::print(stderr, "stopped by a signal: {} is consistent and incomplete; run the same command with "
-                           "--resume to finish it\n",
-                   r.output.string());
+        fmt::print(stderr, "stopped {}: the run is kept in {} (consistent, {} not written yet); run the same command "
+                           "with --resume to finish it\n",
+                   StopSignals::which() != 0 ? "by a signal" : "after --stop-after seconds",
+                   layout::partial_path(r.output).string(), r.output.string());
     }
 }
 

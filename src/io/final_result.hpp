@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 #include "job/grid.hpp"
 #include "job/job.hpp"
@@ -29,6 +30,7 @@ struct FinishReport {
     std::uint64_t raw_bytes = 0;   // of the data uncompressed
     std::uint64_t file_bytes = 0;  // of the result file
     double seconds = 0;
+    std::string sidecar_note;      // "sidecar: PATH", or why there is none
 };
 
 // Collective: writes the result of `job` at `output` from the partial file `partial`

@@ -280,6 +280,20 @@ void write_attribute(hid_t obj, const std::string& name, const std::string& valu
 
 void write_attribute(hid_t obj, const std::string& name, const char* value) { write_attribute(obj, name, std::string(value)); }
 
+void write_text_attribute(hid_t obj, const std::string& name, const std::string& value)
+{
+    // As netCDF-4 itself writes text: the characters, null-terminated if there is room.
+    const Id type = type_id(H5Tcopy(H5T_C_S1), "H5Tcopy");
+    check(H5Tset_size(type, std::max<std::size_t>(value.size(), 1)), "H5Tset_size");
+    check(H5Tset_strpad(type, H5T_STR_NULLTERM), "H5Tset_strpad");
+    check(H5Tset_cset(type, H5T_CSET_ASCII), "H5Tset_cset");
+    const Id space = space_id(H5Screate(H5S_SCALAR), "H5Screate");
+    const Id attr = create_attribute(obj, name, type, space);
+    std::string buf = value;
+    buf.resize(std::max<std::size_t>(value.size(), 1), '\0');
+    check(H5Awrite(attr, type, buf.data()), "H5Awrite " + name);
+}
+
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values)
 {
     const Id type = variable_string_type();

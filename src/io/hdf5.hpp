@@ -156,6 +156,10 @@ void write_attribute(hid_t obj, const std::string& name, const std::string& valu
 void write_attribute(hid_t obj, const std::string& name, const char* value);
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values);
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::uint64_t>& values);
+// Text as a fixed-length ASCII string: netCDF reads it as a text (NC_CHAR) attribute,
+// which every netCDF tool handles (NCO drops NC_STRING `coordinates`); for CF's
+// descriptive attributes. `value` must be ASCII.
+void write_text_attribute(hid_t obj, const std::string& name, const std::string& value);
 // An array of unsigned bytes (netCDF's flag_values must have the variable's own type).
 void write_attribute(hid_t obj, const std::string& name, std::span<const std::uint8_t> values);
 

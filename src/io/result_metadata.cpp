@@ -12,8 +12,8 @@ namespace {
 void describe_variable(hid_t d, const std::string& name)
 {
     const layout::VariableText t = layout::variable_text(name);
-    h5::write_attribute(d, "long_name", std::string(t.long_name));
-    h5::write_attribute(d, "units", std::string(t.units));
+    h5::write_text_attribute(d, "long_name", std::string(t.long_name));
+    h5::write_text_attribute(d, "units", std::string(t.units));
 }
 
 // A small contiguous float64 dataset, its space allocated at creation (parallel files
@@ -63,9 +63,9 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
 
     h5::write_attribute(file, layout::kind_attribute, kind);
     h5::write_attribute(file, "superball_format", layout::format_version);
-    h5::write_attribute(file, "Conventions", "CF-1.8");
-    h5::write_attribute(file, "title", "superball: wall bounces of a superball between a floor and a wall, over a grid of launches");
-    h5::write_attribute(file, "source", std::string("superball ") + software_version);
+    h5::write_text_attribute(file, "Conventions", "CF-1.8");
+    h5::write_text_attribute(file, "title", "superball: wall bounces of a superball between a floor and a wall, over a grid of launches");
+    h5::write_text_attribute(file, "source", std::string("superball ") + software_version);
     // Not "coordinates": that is CF's keyword for auxiliary coordinates, which xarray takes.
     h5::write_attribute(file, "coordinate_system", std::string(name(job.coordinates)));
     h5::write_attribute(file, "axis_names", axis_names);
@@ -104,17 +104,17 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
 
 void describe_data(hid_t wall_bounces, hid_t outcome, const Job& job, const std::vector<h5::Id>& axes)
 {
-    h5::write_attribute(wall_bounces, "long_name", "wall impacts before the motion ended, or max_bounces (capped)");
-    h5::write_attribute(wall_bounces, "units", "1");
-    h5::write_attribute(outcome, "long_name", "how the motion ended");
+    h5::write_text_attribute(wall_bounces, "long_name", "wall impacts before the motion ended, or max_bounces (capped)");
+    h5::write_text_attribute(wall_bounces, "units", "1");
+    h5::write_text_attribute(outcome, "long_name", "how the motion ended");
     h5::write_attribute(outcome, "flag_values", std::span<const std::uint8_t>(layout::outcome_codes));
-    h5::write_attribute(outcome, "flag_meanings", layout::outcome_meanings);
+    h5::write_text_attribute(outcome, "flag_meanings", layout::outcome_meanings);
     std::string fixed;
     for (const Coordinate& c : job.grid) {
         if (!c.is_range()) fixed += (fixed.empty() ? "" : " ") + c.name;
     }
     for (const hid_t d : {wall_bounces, outcome}) {
-        if (!fixed.empty()) h5::write_attribute(d, "coordinates", fixed);
+        if (!fixed.empty()) h5::write_text_attribute(d, "coordinates", fixed);
         for (std::size_t k = 0; k < axes.size(); ++k) h5::attach_dimension_scale(d, axes[k], static_cast<unsigned>(k));
     }
 }

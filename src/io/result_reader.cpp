@@ -679,25 +679,32 @@ std::uint64_t ResultReader::read_checked(const Box& box, std::span<std::uint32_t
             h5::check(H5Dread(d, H5T_NATIVE_UINT8, memory, space, H5P_DEFAULT, outcomes.data()), "read /outcome");
         }
     }
-    // Points of tiles not done hold whatever the disk held: mask them.
+    // Points of tiles not done hold whatever the disk held: mask them, a run of a row at a
+    // time (a row of the box crosses a tile every tile_shape.back() points).
     std::vector<std::uint8_t> computed;
     std::uint64_t missing = 0;
     if (info_.kind == FileKind::partial && info_.tiles_done < info_.tiles) {
         const std::size_t d = box.count.size();
         computed.assign(box.points(), 1);
-        Extent index(d, 0);
         Extent per_axis(d);
         for (std::size_t k = 0; k < d; ++k) per_axis[k] = (info_.shape[k] + info_.tile_shape[k] - 1) / info_.tile_shape[k];
-        for (std::uint64_t p = 0; p < box.points(); ++p) {
-            std::uint64_t t = 0;
-            for (std::size_t k = 0; k < d; ++k) t = t * per_axis[k] + (box.start[k] + index[k]) / info_.tile_shape[k];
-            if (done_[t] == 0) {
-                computed[p] = 0;
-                counts[p] = 0;
-                outcomes[p] = 0;
-                ++missing;
+        const std::uint64_t row = box.count[d - 1], width = info_.tile_shape[d - 1];
+        Extent index(d, 0);
+        for (std::uint64_t p = 0; p < box.points(); p += row) {
+            std::uint64_t prefix = 0;  // the tile's index without its last coordinate
+            for (std::size_t k = 0; k + 1 < d; ++k) prefix = prefix * per_axis[k] + (box.start[k] + index[k]) / info_.tile_shape[k];
+            for (std::uint64_t j = 0; j < row;) {
+                const std::uint64_t column = box.start[d - 1] + j;
+                const std::uint64_t end = std::min(row, j + width - column % width);
+                if (done_[prefix * per_axis[d - 1] + column / width] == 0) {
+                    std::fill(computed.begin() + static_cast<std::ptrdiff_t>(p + j), computed.begin() + static_cast<std::ptrdiff_t>(p + end), 0);
+                    std::fill(counts.begin() + static_cast<std::ptrdiff_t>(p + j), counts.begin() + static_cast<std::ptrdiff_t>(p + end), 0u);
+                    std::fill(outcomes.begin() + static_cast<std::ptrdiff_t>(p + j), outcomes.begin() + static_cast<std::ptrdiff_t>(p + end), 0);
+                    missing += end - j;
+                }
+                j = end;
             }
-            for (std::size_t k = d; k-- > 0;) {
+            for (std::size_t k = d - 1; k-- > 0;) {
                 if (++index[k] < box.count[k]) break;
                 index[k] = 0;
             }
@@ -742,14 +749,26 @@ OutcomeCounts ResultReader::outcome_counts() const
     OutcomeCounts out;
     std::vector<std::uint32_t> counts;
     std::vector<std::uint8_t> outcomes;
-    // About 16 Mi points at a time.
-    for_each_block(info_.shape, std::uint64_t{1} << 24, [&](const Box& box) {
+    const auto add = [&](const Box& box) {
         counts.resize(box.points());
         outcomes.resize(box.points());
-        out.not_computed += read(box, counts, outcomes);
+        read(box, counts, outcomes);
         for (const std::uint8_t o : outcomes) ++out.by_outcome[o];
-    });
-    out.by_outcome[0] -= out.not_computed;  // masked points read as invalid
+    };
+    if (info_.kind == FileKind::partial) {
+        // Only the tiles done: an interrupted run of 10^10 points may have done few.
+        std::uint64_t computed = 0;
+        for (std::uint64_t t = 0; t < info_.tiles; ++t) {
+            if (done_[t] == 0) continue;
+            const Box box = tiling_->box(t);
+            add(box);
+            computed += box.points();
+        }
+        out.not_computed = info_.points() - computed;
+        return out;
+    }
+    // A result: about 16 Mi points at a time.
+    for_each_block(info_.shape, std::uint64_t{1} << 24, add);
     return out;
 }
 

@@ -4,6 +4,9 @@
 #include <fmt/os.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <utility>
 
 #include "layout.hpp"
 #include "result_reader.hpp"
@@ -62,18 +65,26 @@ std::vector<MeshAxis> mesh_axes(const ResultInfo& info)
 
 }  // namespace
 
+std::string xdmf_unsupported(const std::filesystem::path& result)
+{
+    // XDMF names a dataset FILE:PATH with no way to escape a colon in FILE: the legacy
+    // reader splits at the first and last colons, the Xdmf3 readers abort pvpython.
+    if (result.filename().string().find(':') != std::string::npos) return "XDMF cannot name a file whose name has a colon";
+    if (layout::sidecar_path(result) == result) return "the result's own name ends in .xmf";
+    const ResultReader reader(result);
+    if (mesh_axes(reader.info()).size() != 3) return "XDMF has no mesh for a result of more than 3 axes";
+    return "";
+}
+
 std::filesystem::path write_xdmf(const std::filesystem::path& result)
 {
+    if (!xdmf_unsupported(result).empty()) return {};
     const ResultReader reader(result);
     const ResultInfo& info = reader.info();
     const std::vector<MeshAxis> axes = mesh_axes(info);
-    if (axes.size() != 3) return {};
     const std::filesystem::path out = layout::sidecar_path(result);
     const std::string h5 = xml_escape(result.filename().string());
     const std::string mesh_dims = fmt::format("{} {} {}", axes[0].n, axes[1].n, axes[2].n);
-    std::vector<std::string> data_dims;
-    for (const auto n : info.shape) data_dims.push_back(std::to_string(n));
-    const std::string dims = fmt::format("{}", fmt::join(data_dims, " "));
 
     auto f = fmt::output_file(out.string());
     f.print("<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n <Domain>\n");
@@ -94,14 +105,20 @@ std::filesystem::path write_xdmf(const std::filesystem::path& result)
         }
     }
     f.print("   </Geometry>\n");
-    // The data keep their own dimensions in the file; a function item gives them the
-    // mesh's (the same values, with the thin dimensions inserted).
-    for (const char* name : {"wall_bounces", "outcome"}) {
+    // The data are declared with the mesh's dimensions, which have the same points in the
+    // same order as the file's (the thin dimensions have one sample). A Function or
+    // HyperSlab item that reshaped them would be exact, but the Xdmf3 readers of ParaView
+    // 5.11 cannot read such items as attributes ("Skipping unrecognized array type"): they
+    // take the type of an array before reading it. The legacy reader reads the whole
+    // dataset by its number of points; reading pieces of a 2-D result (ParaView in
+    // parallel, the reader's Stride) it selects a hyperslab of the mesh's rank in the
+    // file's and fails, saying so (README: ParaView).
+    const std::string count_type = info.max_bounces > std::numeric_limits<std::int32_t>::max() ? "8" : "4";
+    for (const auto& [name, precision] : {std::pair{"wall_bounces", count_type}, std::pair{"outcome", std::string("4")}}) {
         f.print("   <Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"Node\">\n", name);
-        f.print("    <DataItem ItemType=\"Function\" Function=\"$0\" Dimensions=\"{}\">\n", mesh_dims);
-        f.print("     <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">{}:/{}</DataItem>\n",
-                dims, h5, name);
-        f.print("    </DataItem>\n   </Attribute>\n");
+        f.print("    <DataItem Dimensions=\"{}\" NumberType=\"Int\" Precision=\"{}\" Format=\"HDF\">{}:/{}</DataItem>\n",
+                mesh_dims, precision, h5, name);
+        f.print("   </Attribute>\n");
     }
     f.print("  </Grid>\n </Domain>\n</Xdmf>\n");
     return out;

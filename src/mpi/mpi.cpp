@@ -26,6 +26,18 @@ Environment::Environment()
 
 Environment::~Environment() { MPI_Finalize(); }
 
+Info::Info() { check(MPI_Info_create(&info_), "MPI_Info_create"); }
+
+Info::~Info()
+{
+    if (info_ != MPI_INFO_NULL) MPI_Info_free(&info_);
+}
+
+void Info::set(const std::string& key, const std::string& value)
+{
+    check(MPI_Info_set(info_, key.c_str(), value.c_str()), "MPI_Info_set");
+}
+
 int Comm::rank() const
 {
     int r = 0;

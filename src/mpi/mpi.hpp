@@ -30,6 +30,20 @@ public:
     Environment& operator=(const Environment&) = delete;
 };
 
+// An MPI_Info object of hints (MPI-IO's, here), freed with the object.
+class Info {
+public:
+    Info();
+    ~Info();
+    Info(const Info&) = delete;
+    Info& operator=(const Info&) = delete;
+    void set(const std::string& key, const std::string& value);
+    MPI_Info get() const { return info_; }
+
+private:
+    MPI_Info info_ = MPI_INFO_NULL;
+};
+
 // A communicator borrowed from MPI (not freed here).
 class Comm {
 public:

@@ -467,6 +467,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
         summary.finish_seconds = f.seconds;
         summary.raw_bytes = f.raw_bytes;
         summary.result_bytes = f.file_bytes;
+        summary.sidecar_note = f.sidecar_note;
     }
 
     std::vector<std::uint64_t> totals = work.histogram;

@@ -69,6 +69,7 @@ struct RunSummary {
     double finish_seconds = 0;            // writing the result from the partial file
     std::uint64_t raw_bytes = 0;          // of the data, uncompressed
     std::uint64_t result_bytes = 0;       // of the result file
+    std::string sidecar_note;             // "sidecar: PATH", or why the result has none
     double peak_rss_mib = 0;              // largest over the ranks
     int ranks = 1;
 };

@@ -24,6 +24,11 @@ SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
 
+def text(value):
+    """An HDF5 text attribute as str (h5py gives fixed-length ones as bytes)."""
+    return value.decode("ascii") if isinstance(value, bytes) else str(value)
+
+
 def job_text(grid, model="e = 0.9\nalpha = 0.9", run="max_bounces = 1000"):
     return f"[model]\n{model}\n\n[grid]\n{grid}\n\n[run]\n{run}\n"
 
@@ -115,7 +120,7 @@ class Explore(unittest.TestCase):
             self.assertEqual(sorted(f), ["U", "W", "outcome", "wall_bounces", "xi"])
             for d in (counts, outcome):
                 self.assertEqual([dim[0].name for dim in d.dims], ["/xi", "/W"])
-                self.assertEqual(d.attrs["coordinates"], "U")
+                self.assertEqual(text(d.attrs["coordinates"]), "U")
             self.assertTrue(h5py.h5ds.is_scale(f["xi"].id))
             # Cell centres, computed as SPEC.md section 4 says.
             expect = np.array([0.0 + (i + 0.5) * (1.0 - 0.0) / 61 for i in range(61)])
@@ -123,15 +128,17 @@ class Explore(unittest.TestCase):
             self.assertEqual(f["W"].dtype, np.float64)
             self.assertEqual(f["U"][()], -1.0)
             for name in ("xi", "U", "W"):
-                self.assertEqual(f[name].attrs["units"], "1")
-                self.assertIn(name, f[name].attrs["long_name"])
-            self.assertEqual(counts.attrs["units"], "1")
-            self.assertTrue(counts.attrs["long_name"])
+                self.assertEqual(text(f[name].attrs["units"]), "1")
+                self.assertIn(name, text(f[name].attrs["long_name"]))
+            self.assertEqual(text(counts.attrs["units"]), "1")
+            self.assertTrue(text(counts.attrs["long_name"]))
             self.assertEqual(list(outcome.attrs["flag_values"]), [0, 1, 2, 3])
             self.assertEqual(outcome.attrs["flag_values"].dtype, np.uint8)
-            self.assertEqual(outcome.attrs["flag_meanings"], "invalid left missed capped")
+            self.assertEqual(text(outcome.attrs["flag_meanings"]), "invalid left missed capped")
+            # netCDF text (fixed-length ASCII), not NC_STRING, which some netCDF tools drop.
+            self.assertFalse(h5py.check_string_dtype(outcome.attrs.get_id("flag_meanings").dtype).length is None)
             a = f.attrs
-            self.assertEqual(a["Conventions"], "CF-1.8")
+            self.assertEqual(text(a["Conventions"]), "CF-1.8")
             self.assertEqual(a["coordinate_system"], "canonical")
             self.assertNotIn("coordinates", a)  # CF's keyword for auxiliary coordinates: xarray would take it
             self.assertEqual(list(a["axis_names"]), ["xi", "W"])
@@ -170,6 +177,24 @@ class Explore(unittest.TestCase):
             self.assertGreaterEqual(np.prod(chunks) * 2, 256 * 1024, chunks)
         self.assertLess(os.path.getsize(out), 0.02 * 1024 * 768 * 3)
 
+    def test_ten_billion_points_are_not_filled(self):
+        """Creating the file of a 10^10-point job allocates 30 GB of chunks but writes none of
+        them: the data are never filled, only the journal (9 bytes a tile) and metadata."""
+        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 100000 }\nU = -1.0\n'
+                                      'W = { min = -3.0, max = 3.0, n = 100000 }'))
+        out = self.path("huge.h5")
+        start = time.time()
+        r = self.explore(job, out, 1, ["--stop-after", "0"], expect=1)
+        self.assertIn("--resume", r.stderr)
+        st = os.stat(out + ".partial")
+        self.assertGreaterEqual(st.st_size, 3 * 10**10)        # every chunk allocated...
+        self.assertLess(st.st_blocks * 512, 64 * 2**20, st)     # ...and none written
+        self.assertLess(time.time() - start, 60)
+        # Reading it reads the tiles done, not 30 GB of nothing.
+        info = subprocess.run([SUPERBALL, "info", out], capture_output=True, text=True, timeout=30)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertRegex(info.stdout, r"complete: +no \(0 of \d+ tiles done\)")
+
     def test_uncompressed(self):
         job = self.write_job(job_text(CANONICAL_2D, run="max_bounces = 1000\ncompression = 0"))
         out = self.path("raw.h5")
@@ -203,7 +228,7 @@ class Explore(unittest.TestCase):
             wb, oc = f["wall_bounces"][()], f["outcome"][()]
             u = f["u"][()]
             self.assertEqual(f.attrs["coordinate_system"], "physical")
-            self.assertEqual([f[n].attrs["units"] for n in ("x", "u", "v", "omega")], ["m", "m/s", "m/s", "rad/s"])
+            self.assertEqual([text(f[n].attrs["units"]) for n in ("x", "u", "v", "omega")], ["m", "m/s", "m/s", "rad/s"])
             self.assertEqual(f.attrs["g"], 9.81)
             self.assertEqual(f.attrs["radius"], 0.025)
             self.assertEqual(f.attrs["fixed_v"], 2.0)
