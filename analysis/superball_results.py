@@ -73,6 +73,26 @@ def run_script(main):
     sys.exit(status or 0)
 
 
+def run_superball(command, arguments):
+    """Standard output of `superball COMMAND ARGUMENTS` (the binary from $SUPERBALL, else
+    `superball` on PATH); a leading COMMAND in ARGUMENTS is dropped. A failure becomes a
+    ScriptError with the binary's message and its status (1 or 2)."""
+    import shutil
+    import subprocess
+
+    binary = os.environ.get("SUPERBALL") or shutil.which("superball")
+    if not binary:
+        raise ScriptError("cannot find the superball binary: set SUPERBALL or put superball on PATH", EXIT_FAILURE)
+    if arguments and arguments[0] == command:
+        arguments = arguments[1:]
+    argv = [binary, command] + list(arguments)
+    process = subprocess.run(argv, capture_output=True, text=True)
+    if process.returncode != 0:
+        status = process.returncode if process.returncode in (1, 2) else EXIT_FAILURE
+        raise ScriptError(f"{' '.join(argv)} failed: {process.stderr.strip()}", status)
+    return process.stdout
+
+
 def warn(message):
     """Print a warning on stderr, prefixed with the script's name."""
     print(f"{os.path.basename(sys.argv[0])}: warning: {message}", file=sys.stderr)

@@ -70,6 +70,14 @@ void Comm::broadcast(std::vector<std::uint64_t>& v) const
     check(MPI_Bcast(v.data(), static_cast<int>(n), MPI_UINT64_T, 0, comm_), "MPI_Bcast");
 }
 
+void Comm::broadcast(std::vector<double>& v) const
+{
+    auto n = static_cast<std::uint64_t>(v.size());
+    check(MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm_), "MPI_Bcast");
+    v.resize(n);
+    check(MPI_Bcast(v.data(), static_cast<int>(n), MPI_DOUBLE, 0, comm_), "MPI_Bcast");
+}
+
 std::int64_t Comm::broadcast(std::int64_t x) const
 {
     check(MPI_Bcast(&x, 1, MPI_INT64_T, 0, comm_), "MPI_Bcast");

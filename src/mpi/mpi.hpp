@@ -59,6 +59,7 @@ public:
     // Rank 0's value on every rank.
     void broadcast(std::string& s) const;
     void broadcast(std::vector<std::uint64_t>& v) const;
+    void broadcast(std::vector<double>& v) const;
     std::int64_t broadcast(std::int64_t x) const;
     double broadcast(double x) const;
     // Element-wise sum over ranks, result on every rank.
