@@ -215,8 +215,8 @@ def describe_file(path):
     if is_hdf5(path):
         return "an HDF5 file"
     if all(b >= 0x20 or b in b"\n\r\t" for b in head):
-        first = head.split(b"\n", 1)[0][:40].decode("utf-8", "replace")
-        return f'a text file of {size} bytes, beginning "{first}"'
+        first = head.split(b"\n", 1)[0][:40].decode("utf-8", "backslashreplace")
+        return f'a text file of {size} bytes, beginning "{printable(first)}"'
     return f"a binary file of {size} bytes"
 
 
@@ -233,6 +233,116 @@ def is_hdf5(path):
                 return True
             at = 512 if at == 0 else 2 * at
     return False
+
+
+def printable(text, limit=60):
+    """A text of a file, for a message: at most `limit` characters, with control characters
+    escaped, so that a damaged file cannot garble a terminal (as the
+    C++ reader's messages)."""
+    out = []
+    for ch in str(text)[:limit]:
+        if ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\x{ord(ch):02x}")
+        elif not ch.isprintable():
+            out.append(ch.encode("unicode_escape").decode("ascii"))
+        else:
+            out.append(ch)
+    return "".join(out) + ("..." if len(str(text)) > limit else "")
+
+
+GLOBAL_HEAP_SIGNATURE = b"GCOL\x01\x00\x00\x00"
+
+
+def damaged_global_heap(path, skip):
+    """The offset of the first damaged global heap collection of the file, or None.
+
+    HDF5 1.10 keeps variable-length values (texts, DIMENSION_LIST) in global heap
+    collections, which have no checksum, and trusts the sizes of their objects: a damaged
+    size makes it copy past its buffers when the values are read (a crash or a hang, not
+    an error).  Each collection found outside the byte ranges `skip` (raw data, (offset,
+    size)) is walked as HDF5 walks it (src/io/hdf5.cpp: damaged_global_heap, the same).
+    """
+    size = os.path.getsize(path)
+    block = 16 << 20
+    with open(path, "rb") as f:
+        def intact(at):
+            f.seek(at)
+            header = f.read(16)
+            if len(header) < 16:
+                return False
+            total = int.from_bytes(header[8:16], "little")
+            if total < 4096 or total > size - at or total > (1 << 30):
+                return False
+            f.seek(at)
+            heap = f.read(total)
+            seen, p = set(), 16
+            while p < total and total - p >= 16:
+                index = int.from_bytes(heap[p:p + 2], "little")
+                length = int.from_bytes(heap[p + 8:p + 16], "little")
+                if length > total:
+                    return False
+                need = 16 + (length + 7) // 8 * 8 if index else length
+                if need < 16 or need > total - p or (index and index in seen):
+                    return False
+                seen.add(index)
+                p += need
+            return len(heap) == total
+
+        def scan(start, stop):
+            pos = start
+            while pos < stop:
+                f.seek(pos)
+                data = f.read(min(block, stop - pos))
+                at = data.find(GLOBAL_HEAP_SIGNATURE)
+                while at >= 0:
+                    if not intact(pos + at):
+                        return pos + at
+                    at = data.find(GLOBAL_HEAP_SIGNATURE, at + 1)
+                if len(data) < block:
+                    return None
+                pos += block - (len(GLOBAL_HEAP_SIGNATURE) - 1)
+            return None
+
+        start = 0
+        for offset, length in sorted(skip):
+            if offset > start:
+                bad = scan(start, min(offset, size))
+                if bad is not None:
+                    return bad
+            start = max(start, offset + length)
+        return scan(start, size) if start < size else None
+
+
+def raw_data_ranges(file):
+    """Byte ranges (offset, size) of a file's big raw data, which damaged_global_heap need
+    not search: contiguous datasets, and chunked ones without filters whose chunks lie one
+    after the other (a partial file's)."""
+    ranges = []
+    for name in ("wall_bounces", "outcome", "progress/tile_done", "progress/tile_checksum"):
+        try:
+            dataset = file.get(name)
+            if not isinstance(dataset, h5py.Dataset) or 0 in (dataset.shape or (0,)):
+                continue
+            plist = dataset.id.get_create_plist()
+            if plist.get_layout() != h5py.h5d.CHUNKED:
+                offset = dataset.id.get_offset()
+                if offset is not None:
+                    ranges.append((offset, dataset.id.get_storage_size()))
+                continue
+            if plist.get_nfilters():
+                continue
+            chunk = plist.get_chunk()
+            chunks = math.prod(-(-n // c) for n, c in zip(dataset.shape, chunk))
+            if dataset.id.get_num_chunks() != chunks:
+                continue
+            chunk_bytes = dataset.id.get_type().get_size() * math.prod(chunk)
+            first = dataset.id.get_chunk_info_by_coord((0,) * len(chunk)).byte_offset
+            last = dataset.id.get_chunk_info_by_coord(tuple((n - 1) // c * c for n, c in zip(dataset.shape, chunk)))
+            if last.byte_offset == first + (chunks - 1) * chunk_bytes:
+                ranges.append((first, chunks * chunk_bytes))
+        except H5PY_ERRORS:
+            pass
+    return ranges
 
 
 def shape_text(type_class, shape):
@@ -281,6 +391,11 @@ class Result:
                 hint = "; a run still writing it locks it: wait, or set HDF5_USE_FILE_LOCKING=FALSE to peek"
             raise ScriptError(f"{path} is an HDF5 file that cannot be opened, damaged or truncated ({error}){hint}")
         try:
+            # Before any text is read: HDF5 reads variable-length values without checking them.
+            bad = damaged_global_heap(path, raw_data_ranges(self.file))
+            if bad is not None:
+                self.fail(f"the global heap at byte {bad} (where HDF5 keeps texts and dimension-scale lists) is "
+                          "damaged: its objects do not fit it")
             self._validate()
         except ScriptError:
             self.file.close()
@@ -405,12 +520,12 @@ class Result:
                     version = decode(attrs["software_version"])
                 except H5PY_ERRORS:
                     version = "?"
-                self.fail(f"written by superball {str(version)[:40]} in the layout before netCDF conventions, which this "
+                self.fail(f"written by superball {printable(version)} in the layout before netCDF conventions, which this "
                           "version does not read; run the job again with this version")
             self.fail("an HDF5 file that is not a superball result (no attribute superball_file)")
         self.kind = self._text("superball_file")
         if self.kind not in (KIND_RESULT, KIND_PARTIAL):
-            self.fail(f'attribute superball_file = "{self.kind}" is neither "result" nor "partial"')
+            self.fail(f'attribute superball_file = "{printable(self.kind)}" is neither "result" nor "partial"')
         version = self._integer("superball_format", 0, 2**63 - 1)
         if version != FORMAT_VERSION:
             self.fail(f"attribute superball_format = {version}: this version of superball reads format "
@@ -418,19 +533,19 @@ class Result:
 
         self.coordinates = self._text("coordinate_system")
         if self.coordinates not in COORDINATE_NAMES:
-            self.fail(f'attribute coordinate_system = "{self.coordinates}" is neither canonical nor physical')
+            self.fail(f'attribute coordinate_system = "{printable(self.coordinates)}" is neither canonical nor physical')
         coordinates = COORDINATE_NAMES[self.coordinates]
         self.axis_names = self._texts("axis_names", 4)
         last = -1
         for i, name in enumerate(self.axis_names):
             if name not in coordinates and name not in COEFFICIENT_NAMES:
-                self.fail(f'attribute axis_names names "{name}", which is neither a {self.coordinates} coordinate '
+                self.fail(f'attribute axis_names names "{printable(name)}", which is neither a {self.coordinates} coordinate '
                           f"({', '.join(coordinates)}) nor a model coefficient ({', '.join(COEFFICIENT_NAMES)})")
             if name in self.axis_names[:i]:
                 self.fail(f'attribute axis_names names "{name}" twice')
             order = coordinates.index(name) if name in coordinates else -1
             if order < last:
-                self.fail(f"attribute axis_names lists ({', '.join(self.axis_names)}) out of order: swept "
+                self.fail(f"attribute axis_names lists ({', '.join(map(printable, self.axis_names))}) out of order: swept "
                           f"coefficients first, then {', '.join(coordinates)}")
             last = max(last, order)
         self._fixed = {c: self._number(f"fixed_{c}") for c in coordinates if c not in self.axis_names}
@@ -457,7 +572,7 @@ class Result:
                 value = self._text(key)
                 axis = value[5:] if value.startswith("axis:") else ""
                 if axis not in self.axis_names or axis not in (key, key.split("_")[0]):
-                    self.fail(f'attribute {key} = "{value}" names no axis of the file that sweeps {key}')
+                    self.fail(f'attribute {key} = "{printable(value)}" names no axis of the file that sweeps {key}')
                 swept.add(axis)
                 self._model[key] = value
                 continue

@@ -3,6 +3,7 @@
 #include <H5DSpublic.h>
 
 #include <algorithm>
+#include <utility>
 #include <fstream>
 #include <initializer_list>
 
@@ -442,6 +443,91 @@ std::vector<std::vector<haddr_t>> attached_scales(hid_t data)
     }
     check(H5Dvlen_reclaim(memory, space, H5P_DEFAULT, lists.data()), "H5Dvlen_reclaim");
     return out;
+}
+
+// ------------------------------------------------------------------------- global heap
+
+namespace {
+
+std::uint64_t little_endian(const unsigned char* p, int bytes)
+{
+    std::uint64_t v = 0;
+    for (int i = bytes; i-- > 0;) v = (v << 8) | p[i];
+    return v;
+}
+
+// Whether the collection at `at` (its signature checked) is whole: objects as HDF5's
+// H5HG__cache_heap_deserialize walks them (a 16-byte header: index, references, reserved,
+// size; then the data, padded to 8 bytes; index 0 is the free space, its size counting its
+// header), each inside the collection, the last ending exactly at its end.
+bool collection_intact(std::ifstream& in, std::uint64_t at, std::uint64_t file_size)
+{
+    unsigned char header[16];
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return false;
+    // Version 1, three reserved zero bytes; else HDF5 refuses it itself (an error, no crash).
+    if (header[4] != 1 || header[5] != 0 || header[6] != 0 || header[7] != 0) return true;
+    const std::uint64_t size = little_endian(header + 8, 8);
+    if (size < 4096 || size > file_size - at || size > (std::uint64_t{1} << 30)) return false;
+    std::vector<unsigned char> heap(size);
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(heap.data()), static_cast<std::streamsize>(size))) return false;
+    std::vector<std::uint8_t> seen(65536, 0);
+    std::uint64_t p = 16;
+    while (p < size) {
+        if (size - p < 16) break;  // too small for an object: free space, as HDF5 takes it
+        const auto index = static_cast<std::size_t>(little_endian(&heap[p], 2));
+        const std::uint64_t object = little_endian(&heap[p + 8], 8);
+        if (object > size) return false;
+        const std::uint64_t need = index > 0 ? 16 + ((object + 7) / 8) * 8 : object;
+        if (need < 16 || need > size - p) return false;
+        if (index > 0 && std::exchange(seen[index], std::uint8_t{1}) != 0) return false;
+        p += need;
+    }
+    return true;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> damaged_global_heap(const std::filesystem::path& path,
+                                                 const std::vector<std::pair<std::uint64_t, std::uint64_t>>& skip)
+{
+    std::error_code ec;
+    const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+    if (ec) return std::nullopt;
+    std::ifstream in(path, std::ios::binary);
+    static constexpr char signature[] = {'G', 'C', 'O', 'L', '\x01', '\0', '\0', '\0'};
+    constexpr std::uint64_t block = std::uint64_t{16} << 20;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges(skip);
+    std::sort(ranges.begin(), ranges.end());
+    std::string buf;
+    std::uint64_t from = 0;
+    const auto scan = [&](std::uint64_t a, std::uint64_t b) -> std::optional<std::uint64_t> {
+        // Blocks overlapping by a signature's length less one, so none is cut in two.
+        for (std::uint64_t pos = a; pos < b; pos += block - (sizeof signature - 1)) {
+            const std::uint64_t n = std::min(block, b - pos);
+            buf.resize(n);
+            in.clear();
+            in.seekg(static_cast<std::streamoff>(pos));
+            in.read(buf.data(), static_cast<std::streamsize>(n));
+            buf.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+            for (std::size_t i = buf.find(signature, 0, sizeof signature); i != std::string::npos;
+                 i = buf.find(signature, i + 1, sizeof signature)) {
+                if (!collection_intact(in, pos + i, file_size)) return pos + i;
+            }
+            if (n < block) break;
+        }
+        return std::nullopt;
+    };
+    for (const auto& [offset, size] : ranges) {
+        if (offset > from) {
+            if (const auto bad = scan(from, std::min(offset, file_size))) return bad;
+        }
+        from = std::max(from, offset + size);
+    }
+    if (from < file_size) return scan(from, file_size);
+    return std::nullopt;
 }
 
 // --------------------------------------------------------------------------- selections

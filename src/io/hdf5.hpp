@@ -184,6 +184,18 @@ void attach_dimension_scale(hid_t data, hid_t scale, unsigned dim);
 // not those of the dimension-scale API.
 std::vector<std::vector<haddr_t>> attached_scales(hid_t data);
 
+// ------------------------------------------------------------------------- global heap
+
+// HDF5 1.10 keeps variable-length data (text attributes, DIMENSION_LIST) in global heap
+// collections, which have no checksum, and trusts the sizes of their objects: a damaged
+// size makes it copy past its buffers when the data are read (a crash, or a hang, not an
+// error). Walks every collection found in the file's bytes outside the ranges `skip` (raw
+// data, [offset, offset + size)) as HDF5 will, and returns the offset of the first whose
+// objects do not fit it exactly, or nullopt. To be called before any variable-length
+// value of the file is read.
+std::optional<std::uint64_t> damaged_global_heap(const std::filesystem::path& path,
+                                                 const std::vector<std::pair<std::uint64_t, std::uint64_t>>& skip);
+
 // --------------------------------------------------------------------------- selections
 
 // Selects the box [start, start + count) of `space` (op: H5S_SELECT_SET or _OR).

@@ -32,6 +32,40 @@ constexpr std::size_t max_text_bytes = 4096;
 
 std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
 
+// A text of a file, for a message: at most 60 characters, with control characters and
+// bytes that are not UTF-8 escaped (\xNN), so that a damaged file's bytes can neither
+// garble a terminal nor make the message unreadable.
+std::string printable(std::string_view text)
+{
+    std::string out;
+    std::size_t shown = 0;
+    for (std::size_t i = 0; i < text.size() && shown < 60; ++shown) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        // Length of the UTF-8 sequence c begins, 0 if it begins none.
+        const std::size_t n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+        bool valid = n > 0 && i + n <= text.size();
+        for (std::size_t k = 1; valid && k < n; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        if (n == 1 && c >= 0x20 && c != 0x7f) {
+            out += static_cast<char>(c);
+        } else if (valid && n > 1) {
+            out.append(text.substr(i, n));
+            i += n - 1;
+        } else {
+            out += fmt::format("\\x{:02x}", c);
+        }
+        ++i;
+    }
+    if (shown == 60 && out.size() < text.size()) out += "...";
+    return out;
+}
+
+std::vector<std::string> printable(const std::vector<std::string>& texts)
+{
+    std::vector<std::string> out;
+    for (const std::string& t : texts) out.push_back(printable(t));
+    return out;
+}
+
 std::string dims_text(const std::vector<hsize_t>& dims)
 {
     return dims.empty() ? "a scalar" : fmt::format("({})", fmt::join(dims, ", "));
@@ -197,6 +231,40 @@ bool has_superball_marks(const fs::path& path, std::uint64_t size)
     return has("wall_bounces") && has("outcome");
 }
 
+// The byte ranges of the file's big raw data, which damaged_global_heap need not search:
+// contiguous datasets, and chunked ones without filters whose chunks lie one after the
+// other (a partial file's). Whatever cannot be told is searched.
+std::vector<std::pair<std::uint64_t, std::uint64_t>> raw_data_ranges(hid_t file)
+{
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
+    for (const char* name : {layout::wall_bounces, layout::outcome, layout::tile_done, layout::tile_checksum}) {
+        try {
+            if (h5::object_type(file, name) != h5::ObjectType::dataset) continue;
+            const h5::Id d = h5::open_dataset(file, name);
+            const h5::Shape s = h5::dataset_shape_of(d);
+            const h5::Storage st = h5::dataset_storage(d);
+            if (st.chunk.empty()) {
+                if (const haddr_t at = H5Dget_offset(d); at != HADDR_UNDEF) ranges.emplace_back(at, H5Dget_storage_size(d));
+                continue;
+            }
+            if (st.filters != 0 || !st.allocated || s.elements() == 0) continue;
+            std::uint64_t chunk_bytes = s.bytes, chunks = 1;
+            std::vector<hsize_t> last(s.dims.size());
+            for (std::size_t k = 0; k < s.dims.size(); ++k) {
+                chunk_bytes *= st.chunk[k];
+                chunks *= (s.dims[k] + st.chunk[k] - 1) / st.chunk[k];
+                last[k] = (s.dims[k] - 1) / st.chunk[k] * st.chunk[k];
+            }
+            const std::uint64_t first_at = h5::chunk_offset(d, std::vector<hsize_t>(s.dims.size(), 0));
+            if (h5::chunk_offset(d, last) == first_at + (chunks - 1) * chunk_bytes) {
+                ranges.emplace_back(first_at, chunks * chunk_bytes);
+            }
+        } catch (const h5::Error&) {
+        }
+    }
+    return ranges;
+}
+
 }  // namespace
 
 std::uint64_t ResultInfo::points() const
@@ -241,7 +309,7 @@ FileIdentity identify_file(const fs::path& path)
     });
     if (!text) return {false, fmt::format("a binary file of {} bytes", size)};
     const std::string first = head.substr(0, head.find('\n')).substr(0, 40);
-    return {false, fmt::format("a text file of {} bytes, beginning \"{}\"", size, first)};
+    return {false, fmt::format("a text file of {} bytes, beginning \"{}\"", size, printable(first))};
 }
 
 std::string describe_file(const fs::path& path) { return identify_file(path).description; }
@@ -261,6 +329,13 @@ void ResultReader::validate()
     const Checker check(file_, path_);
     ResultInfo& in = info_;
 
+    // Before any text is read: HDF5 reads variable-length values without checking them.
+    if (const std::optional<std::uint64_t> at = h5::damaged_global_heap(path_, raw_data_ranges(file_))) {
+        check.fail(fmt::format("the global heap at byte {} (where HDF5 keeps texts and dimension-scale lists) is damaged: "
+                               "its objects do not fit it",
+                               *at));
+    }
+
     // What the file is.
     if (!h5::has_attribute(file_, layout::kind_attribute)) {
         // Attributes only this layout has: the file is of this layout, damaged.
@@ -273,7 +348,7 @@ void ResultReader::validate()
                 version = h5::read_string_attribute(file_, "software_version");
             } catch (const h5::Error&) {
             }
-            check.fail("written by superball " + version.substr(0, 40) +
+            check.fail("written by superball " + printable(version) +
                        " in the layout before netCDF conventions, which this version does not read; run the job again "
                        "with this version");
         }
@@ -281,7 +356,7 @@ void ResultReader::validate()
     }
     const std::string kind = check.text(layout::kind_attribute);
     if (kind != layout::kind_result && kind != layout::kind_partial) {
-        check.fail(fmt::format("attribute {} = \"{}\" is neither \"{}\" nor \"{}\"", layout::kind_attribute, kind,
+        check.fail(fmt::format("attribute {} = \"{}\" is neither \"{}\" nor \"{}\"", layout::kind_attribute, printable(kind),
                                layout::kind_result, layout::kind_partial));
     }
     in.kind = kind == layout::kind_result ? FileKind::result : FileKind::partial;
@@ -295,7 +370,7 @@ void ResultReader::validate()
     // The grid's coordinates and axes.
     in.coordinate_system = check.text("coordinate_system");
     if (in.coordinate_system != "canonical" && in.coordinate_system != "physical") {
-        check.fail("attribute coordinate_system = \"" + in.coordinate_system + "\" is neither canonical nor physical");
+        check.fail("attribute coordinate_system = \"" + printable(in.coordinate_system) + "\" is neither canonical nor physical");
     }
     const std::vector<std::string> coordinates = coordinates_of(in.coordinate_system);
     in.axis_names = check.texts("axis_names", 4);
@@ -306,14 +381,15 @@ void ResultReader::validate()
         if (c == coordinates.end() && !is_coefficient(a)) {
             check.fail(fmt::format("attribute axis_names names \"{}\", which is neither a {} coordinate ({}) nor a model "
                                    "coefficient ({})",
-                                   a, in.coordinate_system, fmt::join(coordinates, ", "), fmt::join(coefficient_names(), ", ")));
+                                   printable(a), in.coordinate_system, fmt::join(coordinates, ", "),
+                                   fmt::join(coefficient_names(), ", ")));
         }
         if (!seen.insert(a).second) check.fail("attribute axis_names names \"" + a + "\" twice");
         // Swept coefficients first, then the coordinates in their order (as written).
         const std::ptrdiff_t order = c == coordinates.end() ? -1 : c - coordinates.begin();
         if (order < last_coordinate) {
             check.fail(fmt::format("attribute axis_names lists ({}) out of order: swept coefficients first, then {}",
-                                   fmt::join(in.axis_names, ", "), fmt::join(coordinates, ", ")));
+                                   fmt::join(printable(in.axis_names), ", "), fmt::join(coordinates, ", ")));
         }
         last_coordinate = std::max(last_coordinate, order);
     }
@@ -350,7 +426,7 @@ void ResultReader::validate()
             const std::string v = check.text(key);
             const std::string axis = v.rfind("axis:", 0) == 0 ? v.substr(5) : "";
             if (std::find(in.axis_names.begin(), in.axis_names.end(), axis) == in.axis_names.end() || !sweeps(axis, key)) {
-                check.fail(fmt::format("attribute {} = \"{}\" names no axis of the file that sweeps {}", key, v, key));
+                check.fail(fmt::format("attribute {} = \"{}\" names no axis of the file that sweeps {}", key, printable(v), key));
             }
             swept.insert(axis);
             continue;

@@ -153,17 +153,15 @@ bool is_superball_sidecar(const fs::path& path)
 std::optional<Decision> check_companions(const ExploreSettings& s, const fs::path& out)
 {
     const fs::path sidecar = layout::sidecar_path(out);
-    if (sidecar == out) {
-        return refuse(out.string() + ": a result's name cannot end in .xmf, the name of its ParaView sidecar; choose another "
-                                     "--output");
-    }
     std::error_code ec;
     const fs::path finishing = layout::finishing_path(out);
     if (fs::exists(finishing, ec) || fs::is_symlink(finishing, ec)) {
         const FileIdentity id = identify_file(finishing);
         if (!id.superball) return refuse_foreign(s, finishing, id, " (where the result is written before it takes its name)");
     }
-    if (fs::exists(sidecar, ec) || fs::is_symlink(sidecar, ec)) {
+    // A result named *.xmf, or with a colon in its name, gets no sidecar (xdmf_unsupported).
+    const bool gets_sidecar = sidecar != out && out.filename().string().find(':') == std::string::npos;
+    if (gets_sidecar && (fs::exists(sidecar, ec) || fs::is_symlink(sidecar, ec))) {
         if (!is_superball_sidecar(sidecar)) {
             return refuse_foreign(s, sidecar, identify_file(sidecar), " (where the result's ParaView sidecar goes)");
         }
