@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <limits>
 #include <tuple>
@@ -38,8 +37,8 @@ std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
 std::string printable(std::string_view text)
 {
     std::string out;
-    std::size_t shown = 0;
-    for (std::size_t i = 0; i < text.size() && shown < 60; ++shown) {
+    std::size_t i = 0;
+    for (std::size_t shown = 0; i < text.size() && shown < 60; ++shown) {
         const auto c = static_cast<unsigned char>(text[i]);
         // Length of the UTF-8 sequence c begins, 0 if it begins none.
         const std::size_t n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
@@ -55,7 +54,7 @@ std::string printable(std::string_view text)
         }
         ++i;
     }
-    if (shown == 60 && out.size() < text.size()) out += "...";
+    if (i < text.size()) out += "...";
     return out;
 }
 

@@ -50,24 +50,28 @@ rm -f "$out/generated/superball/version.hpp.tmp"
 hdf5=($(pkg-config --cflags hdf5-openmpi libxxhash) -I/usr/include/eigen3 -I"$out/generated")
 hdf5_libs=($(pkg-config --libs hdf5-openmpi libxxhash) -lhdf5_hl -lfmt $(mpicxx --showme:link))
 
-# build NAME SOURCES... -- EXTRA FLAGS...: rebuilds build/fuzz/NAME when a source, a header
-# of src/ or this script is newer than the last build.
+# build NAME DEPENDENCIES -- SOURCES... -- EXTRA FLAGS...: rebuilds build/fuzz/NAME when a
+# source, a file of DEPENDENCIES (a find expression's paths) or this script is newer than
+# the last build.
 build() {
-  local name=$1; shift
+  local name=$1 deps=$2; shift 2
+  shift  # --
   local sources=() extra=()
   while (($# > 0)) && [[ $1 != -- ]]; do sources+=("$1"); shift; done
   (($# > 0)) && shift && extra=("$@")
   local stamp=$out/$name.stamp
-  if [[ ! -x $out/$name ]] || [[ -n $(cd "$root" && find "${sources[@]}" src -name '*.hpp' -newer "$stamp" 2>/dev/null;
-                                      find tests/fuzz/toml_assert.hpp tests/fuzz/run.sh -newer "$stamp" 2>/dev/null) ]]; then
+  # shellcheck disable=SC2086
+  if [[ ! -x $out/$name ]] || [[ -n $(cd "$root" && find "${sources[@]}" $deps tests/fuzz/toml_assert.hpp tests/fuzz/run.sh \
+                                        -newer "$stamp" 2>/dev/null) ]]; then
     echo "fuzz: building $out/$name" >&2
     (cd "$root" && "$cxx" "${flags[@]}" "${sources[@]}" "${extra[@]}" -o "$out/$name.tmp")
     mv "$out/$name.tmp" "$out/$name"
     touch "$stamp"
   fi
 }
-build fuzz_job tests/fuzz/fuzz_job.cpp "${job_sources[@]}"
-build fuzz_result tests/fuzz/fuzz_result.cpp "${result_sources[@]}" "${job_sources[@]}" -- "${hdf5[@]}" "${hdf5_libs[@]}"
+build fuzz_job "src/job/job.hpp src/job/spelling.hpp src/core/input.hpp src/core/model.hpp src/core/state.hpp" -- \
+  tests/fuzz/fuzz_job.cpp "${job_sources[@]}"
+build fuzz_result "src" -- tests/fuzz/fuzz_result.cpp "${result_sources[@]}" "${job_sources[@]}" -- "${hdf5[@]}" "${hdf5_libs[@]}"
 
 # libFuzzer writes new inputs into the first corpus directory: scratch copies, so the
 # checked-in seeds stay as they are.
