@@ -22,12 +22,14 @@ Runner add_info_command(CLI::App& app)
         h5::silence_errors();
         std::filesystem::path p = *path;
         std::error_code ec;
-        if (!std::filesystem::exists(p, ec) && std::filesystem::exists(layout::partial_path(p), ec)) {
-            fmt::print("{} does not exist yet: its run is not finished; its partial file:\n", p.string());
-            p = layout::partial_path(p);
-        }
+        const bool unfinished = !std::filesystem::exists(p, ec) && std::filesystem::exists(layout::partial_path(p), ec);
+        if (unfinished) p = layout::partial_path(p);
         const ResultReader reader(p);
         const ResultInfo& info = reader.info();
+        // Every value is read (and checked) before anything is printed: a damaged file gets
+        // one message, not half a report.
+        const OutcomeCounts h = reader.outcome_counts();
+        if (unfinished) fmt::print("{} does not exist yet: its run is not finished; its partial file:\n", path->c_str());
         std::string shape;
         for (std::size_t k = 0; k < info.shape.size(); ++k) {
             shape += fmt::format("{}{} {}", k ? " x " : "", info.shape[k], info.axis_names[k]);
@@ -45,7 +47,6 @@ Runner add_info_command(CLI::App& app)
         fmt::print("max_bounces: {}\n", info.max_bounces);
         fmt::print("written by:  superball {} on {} rank{}, {:.2f} s in all\n", info.software_version, info.mpi_ranks,
                    info.mpi_ranks == 1 ? "" : "s", info.wall_seconds);
-        const OutcomeCounts h = reader.outcome_counts();
         fmt::print("outcomes{}:\n", h.not_computed ? " (of the points computed so far)" : "");
         const std::uint64_t computed = info.points() - h.not_computed;
         for (int o = 0; o < outcome_count; ++o) {

@@ -3,6 +3,7 @@
 #include <H5DSpublic.h>
 
 #include <algorithm>
+#include <utility>
 #include <fstream>
 #include <initializer_list>
 
@@ -123,9 +124,16 @@ Shape shape_of(hid_t type, hid_t space)
         case H5T_INTEGER:
             s.type = TypeClass::integer;
             s.is_signed = H5Tget_sign(type) == H5T_SGN_2;
+            s.little_endian = H5Tget_order(type) == H5T_ORDER_LE;
             break;
-        case H5T_FLOAT: s.type = TypeClass::floating; break;
-        case H5T_STRING: s.type = TypeClass::string; break;
+        case H5T_FLOAT:
+            s.type = TypeClass::floating;
+            s.little_endian = H5Tget_order(type) == H5T_ORDER_LE;
+            break;
+        case H5T_STRING:
+            s.type = TypeClass::string;
+            s.variable_length = H5Tis_variable_str(type) > 0;
+            break;
         default: s.type = TypeClass::other; break;
     }
     s.bytes = H5Tget_size(type);
@@ -157,6 +165,40 @@ std::vector<hsize_t> dataset_shape(hid_t dataset)
     std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
     check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), "H5Sget_simple_extent_dims");
     return dims;
+}
+
+Storage dataset_storage(hid_t dataset)
+{
+    Storage st;
+    const Id dcpl = plist_id(H5Dget_create_plist(dataset), "H5Dget_create_plist");
+    const Shape s = dataset_shape_of(dataset);
+    const H5D_layout_t layout = H5Pget_layout(dcpl);
+    if (layout == H5D_CHUNKED) {
+        st.chunk.resize(s.dims.size());
+        const int rank = check(H5Pget_chunk(dcpl, static_cast<int>(st.chunk.size()), st.chunk.data()), "H5Pget_chunk");
+        if (static_cast<std::size_t>(rank) != s.dims.size()) throw Error("HDF5: the chunks' rank differs from the dataset's");
+        st.filters = check(H5Pget_nfilters(dcpl), "H5Pget_nfilters");
+        // Chunks expected: the grid of chunks over the extent.
+        hsize_t expected = 1;
+        for (std::size_t k = 0; k < s.dims.size(); ++k) {
+            if (st.chunk[k] == 0) throw Error("HDF5: a chunk dimension is 0");
+            expected *= (s.dims[k] + st.chunk[k] - 1) / st.chunk[k];
+        }
+        const Id space = space_id(H5Dget_space(dataset), "H5Dget_space");
+        hsize_t chunks = 0;
+        check(H5Dget_num_chunks(dataset, space, &chunks), "H5Dget_num_chunks");
+        st.allocated = chunks == expected;
+    } else if (layout == H5D_CONTIGUOUS || layout == H5D_COMPACT) {
+        st.allocated = H5Dget_storage_size(dataset) == s.elements() * s.bytes;
+    }
+    return st;
+}
+
+haddr_t object_address(hid_t object)
+{
+    H5O_info_t info{};
+    check(H5Oget_info2(object, &info, H5O_INFO_BASIC), "H5Oget_info");
+    return info.addr;
 }
 
 std::uint64_t contiguous_offset(hid_t dataset)
@@ -373,6 +415,119 @@ void make_dimension_scale(hid_t dataset, const std::string& name)
 void attach_dimension_scale(hid_t data, hid_t scale, unsigned dim)
 {
     check(H5DSattach_scale(data, scale, dim), "H5DSattach_scale");
+}
+
+std::vector<std::vector<haddr_t>> attached_scales(hid_t data)
+{
+    static constexpr const char* name = "DIMENSION_LIST";
+    if (!has_attribute(data, name)) return {};
+    const Id attr = open_attribute(data, name);
+    const Id type = type_id(H5Aget_type(attr), "H5Aget_type");
+    const Id space = space_id(H5Aget_space(attr), "H5Aget_space");
+    const int rank = check(H5Sget_simple_extent_ndims(space), "H5Sget_simple_extent_ndims");
+    const Id base = H5Tget_class(type) == H5T_VLEN ? type_id(H5Tget_super(type), "H5Tget_super") : Id{};
+    if (H5Sget_simple_extent_type(space) != H5S_SIMPLE || rank != 1 || !base.valid() ||
+        H5Tequal(base, H5T_STD_REF_OBJ) <= 0) {
+        throw Error("attribute DIMENSION_LIST is not a list of object references per dimension");
+    }
+    hsize_t n = 0;
+    check(H5Sget_simple_extent_dims(space, &n, nullptr), "H5Sget_simple_extent_dims");
+    if (n > 32) throw Error("attribute DIMENSION_LIST lists more than 32 dimensions");
+    const Id memory = type_id(H5Tvlen_create(H5T_STD_REF_OBJ), "H5Tvlen_create");
+    std::vector<hvl_t> lists(n, hvl_t{0, nullptr});
+    check(H5Aread(attr, memory, lists.data()), "H5Aread DIMENSION_LIST");
+    std::vector<std::vector<haddr_t>> out(n);
+    for (hsize_t k = 0; k < n; ++k) {
+        const auto* refs = static_cast<const hobj_ref_t*>(lists[k].p);
+        if (refs != nullptr) out[k].assign(refs, refs + lists[k].len);
+    }
+    check(H5Dvlen_reclaim(memory, space, H5P_DEFAULT, lists.data()), "H5Dvlen_reclaim");
+    return out;
+}
+
+// ------------------------------------------------------------------------- global heap
+
+namespace {
+
+std::uint64_t little_endian(const unsigned char* p, int bytes)
+{
+    std::uint64_t v = 0;
+    for (int i = bytes; i-- > 0;) v = (v << 8) | p[i];
+    return v;
+}
+
+// Whether the collection at `at` (its signature checked) is whole: objects as HDF5's
+// H5HG__cache_heap_deserialize walks them (a 16-byte header: index, references, reserved,
+// size; then the data, padded to 8 bytes; index 0 is the free space, its size counting its
+// header), each inside the collection, the last ending exactly at its end.
+bool collection_intact(std::ifstream& in, std::uint64_t at, std::uint64_t file_size)
+{
+    unsigned char header[16];
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return false;
+    // Version 1, three reserved zero bytes; else HDF5 refuses it itself (an error, no crash).
+    if (header[4] != 1 || header[5] != 0 || header[6] != 0 || header[7] != 0) return true;
+    const std::uint64_t size = little_endian(header + 8, 8);
+    if (size < 4096 || size > file_size - at || size > (std::uint64_t{1} << 30)) return false;
+    std::vector<unsigned char> heap(size);
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(heap.data()), static_cast<std::streamsize>(size))) return false;
+    std::vector<std::uint8_t> seen(65536, 0);
+    std::uint64_t p = 16;
+    while (p < size) {
+        if (size - p < 16) break;  // too small for an object: free space, as HDF5 takes it
+        const auto index = static_cast<std::size_t>(little_endian(&heap[p], 2));
+        const std::uint64_t object = little_endian(&heap[p + 8], 8);
+        if (object > size) return false;
+        const std::uint64_t need = index > 0 ? 16 + ((object + 7) / 8) * 8 : object;
+        if (need < 16 || need > size - p) return false;
+        if (index > 0 && std::exchange(seen[index], std::uint8_t{1}) != 0) return false;
+        p += need;
+    }
+    return true;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> damaged_global_heap(const std::filesystem::path& path,
+                                                 const std::vector<std::pair<std::uint64_t, std::uint64_t>>& skip)
+{
+    std::error_code ec;
+    const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+    if (ec) return std::nullopt;
+    std::ifstream in(path, std::ios::binary);
+    static constexpr char signature[] = {'G', 'C', 'O', 'L', '\x01', '\0', '\0', '\0'};
+    constexpr std::uint64_t block = std::uint64_t{16} << 20;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges(skip);
+    std::sort(ranges.begin(), ranges.end());
+    std::string buf;
+    std::uint64_t from = 0;
+    const auto scan = [&](std::uint64_t a, std::uint64_t b) -> std::optional<std::uint64_t> {
+        // Blocks overlapping by a signature's length less one, so none is cut in two.
+        for (std::uint64_t pos = a; pos < b; pos += block - (sizeof signature - 1)) {
+            const std::uint64_t n = std::min(block, b - pos);
+            buf.resize(n);
+            in.clear();
+            in.seekg(static_cast<std::streamoff>(pos));
+            in.read(buf.data(), static_cast<std::streamsize>(n));
+            buf.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+            for (std::size_t i = buf.find(signature, 0, sizeof signature); i != std::string::npos;
+                 i = buf.find(signature, i + 1, sizeof signature)) {
+                if (!collection_intact(in, pos + i, file_size)) return pos + i;
+            }
+            if (n < block) break;
+        }
+        return std::nullopt;
+    };
+    for (const auto& [offset, size] : ranges) {
+        if (offset > from) {
+            if (const auto bad = scan(from, std::min(offset, file_size))) return bad;
+        }
+        from = std::max(from, offset + size);
+    }
+    if (from < file_size) return scan(from, file_size);
+    return std::nullopt;
 }
 
 // --------------------------------------------------------------------------- selections

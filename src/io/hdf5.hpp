@@ -89,6 +89,7 @@ inline Id space_id(hid_t id, std::string_view what) { return {id, H5Sclose, what
 inline Id plist_id(hid_t id, std::string_view what) { return {id, H5Pclose, what}; }
 inline Id type_id(hid_t id, std::string_view what) { return {id, H5Tclose, what}; }
 inline Id attribute_id(hid_t id, std::string_view what) { return {id, H5Aclose, what}; }
+inline Id object_id(hid_t id, std::string_view what) { return {id, H5Oclose, what}; }
 
 // HDF5 prints its own error stack by default; the messages here say what failed.
 void silence_errors();
@@ -120,6 +121,8 @@ struct Shape {
     TypeClass type = TypeClass::other;
     std::size_t bytes = 0;     // of one element
     bool is_signed = false;    // integers
+    bool little_endian = true; // integers and floating-point numbers
+    bool variable_length = false;  // strings: variable length (`bytes` is then a pointer's)
     bool scalar = false;       // a scalar dataspace
     std::vector<hsize_t> dims; // empty for a scalar
     std::uint64_t elements() const;
@@ -127,6 +130,18 @@ struct Shape {
 Shape dataset_shape_of(hid_t dataset);
 // Dimensions of a dataset.
 std::vector<hsize_t> dataset_shape(hid_t dataset);
+// How a dataset is stored: its chunk dimensions (empty unless chunked), how many filters
+// its chunks pass through, and whether all of its data has storage (every chunk of a
+// chunked dataset allocated, the whole extent of a contiguous one): a dataset without is
+// missing data, which HDF5 would silently read as fill values.
+struct Storage {
+    std::vector<hsize_t> chunk;
+    int filters = 0;
+    bool allocated = false;
+};
+Storage dataset_storage(hid_t dataset);
+// Address of an object's header in its file: what an HDF5 1.10 object reference holds.
+haddr_t object_address(hid_t object);
 // Byte offset of a contiguous dataset's data in the file.
 std::uint64_t contiguous_offset(hid_t dataset);
 // Byte offset of the chunk whose first element is at `coords`.
@@ -163,6 +178,23 @@ std::vector<std::string> read_string_vector_attribute(hid_t obj, const std::stri
 // coordinate variable), and attaches it to dimension `dim` of `data`.
 void make_dimension_scale(hid_t dataset, const std::string& name);
 void attach_dimension_scale(hid_t data, hid_t scale, unsigned dim);
+// The scales attached to each dimension of `data`, as object addresses, read from its
+// DIMENSION_LIST attribute; empty if it has none. Checks the attribute's type and shape
+// before reading it (HDF5's own H5DS functions trust them) and throws Error when they are
+// not those of the dimension-scale API.
+std::vector<std::vector<haddr_t>> attached_scales(hid_t data);
+
+// ------------------------------------------------------------------------- global heap
+
+// HDF5 1.10 keeps variable-length data (text attributes, DIMENSION_LIST) in global heap
+// collections, which have no checksum, and trusts the sizes of their objects: a damaged
+// size makes it copy past its buffers when the data are read (a crash, or a hang, not an
+// error). Walks every collection found in the file's bytes outside the ranges `skip` (raw
+// data, [offset, offset + size)) as HDF5 will, and returns the offset of the first whose
+// objects do not fit it exactly, or nullopt. To be called before any variable-length
+// value of the file is read.
+std::optional<std::uint64_t> damaged_global_heap(const std::filesystem::path& path,
+                                                 const std::vector<std::pair<std::uint64_t, std::uint64_t>>& skip);
 
 // --------------------------------------------------------------------------- selections
 

@@ -2,12 +2,15 @@
 // used by `info`, `analyse`, the resume decision and the viewer. Results are shared
 // between users and files get damaged: the reader trusts nothing. Opening validates the
 // structure (objects, types, shapes, attributes and their agreement); reading validates
-// the values (outcome codes, counts within max_bounces) as they pass.
+// the values (outcome codes, counts against max_bounces, the checksums of a partial
+// file's tiles) as they pass. Every refusal is a FormatError naming the file and the
+// object.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -60,26 +63,29 @@ struct OutcomeCounts {
 
 class ResultReader {
 public:
-    // Opens and validates. Throws FormatError naming what is wrong (not HDF5, not a
-    // superball file, missing or contradictory objects or attributes), h5::Error when the
-    // file cannot be read at all.
+    // Opens and validates. Throws FormatError naming what is wrong: not there, not a
+    // regular file, not HDF5, not a superball file, damaged (HDF5 cannot read its
+    // structure), missing or contradictory objects or attributes.
     explicit ResultReader(const std::filesystem::path& path);
 
     const std::filesystem::path& path() const { return path_; }
     const ResultInfo& info() const { return info_; }
 
-    // Samples of axis k: as many as the dimension, finite, strictly monotonic.
+    // Samples of axis k: as many as the dimension, finite, strictly increasing.
     std::vector<double> axis(std::size_t k) const;
 
-    // Partial files: the journal (FormatError on a flag other than 0 or 1).
+    // Partial files: the journal (flags 0 or 1, checked at open) and the checksums.
     std::vector<std::uint8_t> tiles_done() const;
     std::vector<std::uint64_t> tile_checksums() const;
     // Partial files: done tiles whose data no longer match their checksums (reads them all).
     std::vector<std::uint64_t> damaged_tiles() const;
 
-    // The values of `box`, row-major. Points of tiles not yet done (partial files) read as
-    // 0 bounces, outcome invalid, and are counted in the return value. FormatError on an
-    // outcome code outside 0-3 or a count above max_bounces.
+    // The values of `box` (within the data), row-major, into spans of box.points()
+    // elements. Points of tiles not yet done (partial files) read as 0 bounces, outcome
+    // invalid, and are counted in the return value; a done tile is checked against its
+    // checksum the first time it is read. FormatError on an outcome code outside 0-3, a
+    // count the outcome does not allow (invalid: 0; capped: max_bounces; others: at most
+    // max_bounces), a damaged tile, or data HDF5 cannot read (naming the point or tile).
     std::uint64_t read(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const;
 
     // The whole file, a block of rows at a time.
@@ -87,20 +93,44 @@ public:
 
 private:
     void validate();
+    void validate_partial();
     std::uint64_t read_checked(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const;
     void validate_values(const Box& box, std::span<const std::uint32_t> counts, std::span<const std::uint8_t> outcomes,
                          std::span<const std::uint8_t> computed) const;
+    // Whether done tile t still matches its checksum.
+    bool tile_intact(std::uint64_t t) const;
+    // Checks every done tile that meets `box` and was not checked before.
+    void verify_tiles(const Box& box) const;
 
     std::filesystem::path path_;
     h5::Id file_;
     h5::Id counts_;
     h5::Id outcomes_;
     ResultInfo info_;
-    std::vector<std::uint8_t> done_;  // partial files: the journal, read once
+    std::vector<std::uint8_t> done_;     // partial files: the journal, read once
+    std::vector<std::uint64_t> sums_;    // partial files: the checksums, read once
+    std::optional<Tiling> tiling_;       // partial files
+    // Partial files: tiles whose checksum was checked (read() is const to its callers; the
+    // check is done once per tile, not once per read).
+    mutable std::vector<std::uint8_t> verified_;
 };
 
-// Kind of thing at `path`, for messages that say what a non-result is: "a directory", "a
-// text file", "an HDF5 file that is not a superball result", ...
+// Calls f with boxes covering a grid of `shape` once, each of at most `max_points` points
+// (one point at least), in storage order: whole trailing axes where they fit.
+void for_each_block(const Extent& shape, std::uint64_t max_points, const std::function<void(const Box&)>& f);
+
+// What is at `path`, for messages and for the writer's decision to replace it.
+struct FileIdentity {
+    // A superball file (result or partial, any version), readable or not: one that
+    // `explore --overwrite` may replace.
+    bool superball = false;
+    // "a directory", "a text file of 120 bytes, beginning ...", "a superball file", "a
+    // damaged superball file (...)", "an HDF5 file that is not superball's", ...
+    std::string description;
+};
+FileIdentity identify_file(const std::filesystem::path& path);
+
+// identify_file(path).description.
 std::string describe_file(const std::filesystem::path& path);
 
 }  // namespace superball

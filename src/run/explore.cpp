@@ -2,17 +2,20 @@
 
 #include <fcntl.h>
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <fstream>
 #include <optional>
 #include <system_error>
 #include <utility>
 
 #include "core/count.hpp"
 #include "io/final_result.hpp"
+#include "io/result_metadata.hpp"
 #include "io/layout.hpp"
 #include "io/partial_file.hpp"
 #include "io/posix_file.hpp"
@@ -37,10 +40,15 @@ struct Decision {
 
 Decision refuse(std::string why) { return {Verdict::refuse, std::move(why)}; }
 
-// A file at `path` that --overwrite may replace: a superball file, even a damaged one
-// whose root attributes still say so. Anything else (a thesis, a directory, another
-// program's HDF5 file) is never replaced.
-bool superball_owned(const fs::path& path) { return describe_file(path) == "a superball file"; }
+// Why a file that is not superball's stays where it is: --overwrite replaces superball's
+// files only (a thesis, a directory, another program's HDF5 file are never replaced), and
+// the refusal suggests the flag only where it would help.
+Decision refuse_foreign(const ExploreSettings& s, const fs::path& path, const FileIdentity& id, std::string_view role)
+{
+    return refuse(fmt::format("{} exists{} and is {}: not a superball file, and superball replaces only its own files{}; "
+                              "move it away or choose another --output",
+                              path.string(), role, id.description, s.overwrite ? ", even with --overwrite" : ""));
+}
 
 // Rank 0: what to do with an existing partial file (a run in progress or interrupted).
 Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const Job& job)
@@ -54,8 +62,10 @@ Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const
         problem = e.what();
     }
     if (!problem.empty()) {
-        if (s.overwrite && superball_owned(partial)) return {Verdict::fresh, "replacing " + partial.string() + " (--overwrite)"};
-        return refuse(problem + "; it is left alone: move it away, or choose another --output");
+        const FileIdentity id = identify_file(partial);
+        if (!id.superball) return refuse_foreign(s, partial, id, " (where this output's run keeps its tiles)");
+        if (s.overwrite) return {Verdict::fresh, "replacing " + partial.string() + ", which cannot be resumed (--overwrite)"};
+        return refuse(problem + "; it is left as it is: --overwrite to start the run again, or --output to write elsewhere");
     }
     const ResultInfo& info = reader->info();
     if (s.overwrite) {
@@ -70,6 +80,17 @@ Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const
     if (info.job_fingerprint != fingerprint(job)) {
         return refuse(partial.string() + " was made by a different job (grid, model or max_bounces differ); refusing to mix "
                                          "results: use another --output, or --overwrite");
+    }
+    // The resume writes tiles at offsets computed from the job's grid: a file whose data
+    // disagree with its own fingerprint is not written to.
+    const Extent shape = Grid(job).shape();
+    const std::size_t count_bytes = H5Tget_size(count_type(job));
+    if (info.shape != shape || info.count_bytes != count_bytes) {
+        return refuse(fmt::format("{} is damaged: its data ({}, {}-bit counts) contradict its job_fingerprint ({}, {}-bit "
+                                  "counts); refusing to resume onto it: --overwrite to start again, or --output to write "
+                                  "elsewhere",
+                                  partial.string(), fmt::join(info.shape, " x "), 8 * info.count_bytes,
+                                  fmt::join(shape, " x "), 8 * count_bytes));
     }
     if (info.software_version != software_version) {
         return refuse(fmt::format("{} was made by superball {}, this is {}; refusing to mix results of two versions: use "
@@ -87,7 +108,10 @@ Decision decide_output(const ExploreSettings& s, const fs::path& out, const Job&
         const ResultReader reader(out);
         const ResultInfo& info = reader.info();
         if (info.kind != FileKind::result) {
-            return refuse(out.string() + " is the partial file of a run, not a result; choose another --output");
+            if (s.overwrite) return {Verdict::fresh, "replacing " + out.string() + ", the partial file of a run (--overwrite)"};
+            return refuse(fmt::format("{} holds the partial file of a run ({} of {} tiles done), not a result; --overwrite "
+                                      "to replace it, or --output to write elsewhere",
+                                      out.string(), info.tiles_done, info.tiles));
         }
         if (s.overwrite) {
             return {Verdict::fresh, "replacing " + out.string() + " when the new run completes (--overwrite)"};
@@ -102,14 +126,46 @@ Decision decide_output(const ExploreSettings& s, const fs::path& out, const Job&
         }
         return {Verdict::complete, out.string() + " is already complete: nothing to do"};
     } catch (const InputError& e) {
-        if (superball_owned(out)) {
-            if (s.overwrite) return {Verdict::fresh, "replacing the damaged " + out.string() + " (--overwrite)"};
-            return refuse(std::string(e.what()) + "; --overwrite to replace it, or --output to write elsewhere");
-        }
-        return refuse(fmt::format("{} exists and is {}: superball replaces only its own results, even with --overwrite; "
-                                  "choose another --output or move it away",
-                                  out.string(), describe_file(out)));
+        const FileIdentity id = identify_file(out);
+        if (!id.superball) return refuse_foreign(s, out, id, "");
+        if (s.overwrite) return {Verdict::fresh, "replacing the damaged " + out.string() + " (--overwrite)"};
+        return refuse(std::string(e.what()) + "; --overwrite to replace it, or --output to write elsewhere");
     }
+}
+
+// Whether `path` is an XDMF sidecar as superball writes them (io/xdmf.cpp): XML naming a
+// result's /wall_bounces. A sidecar is small; the first 64 KiB say.
+bool is_superball_sidecar(const fs::path& path)
+{
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) return false;
+    std::ifstream in(path, std::ios::binary);
+    std::string head(64 * 1024, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    return head.rfind("<?xml", 0) == 0 && head.find("<Xdmf") != std::string::npos &&
+           head.find(":/wall_bounces</DataItem>") != std::string::npos;
+}
+
+// Rank 0: the other files a run writes, OUTPUT.finishing (the result before it takes its
+// name) and the sidecar OUTPUT.xmf, are replaced only if they are superball's too.
+std::optional<Decision> check_companions(const ExploreSettings& s, const fs::path& out)
+{
+    const fs::path sidecar = layout::sidecar_path(out);
+    std::error_code ec;
+    const fs::path finishing = layout::finishing_path(out);
+    if (fs::exists(finishing, ec) || fs::is_symlink(finishing, ec)) {
+        const FileIdentity id = identify_file(finishing);
+        if (!id.superball) return refuse_foreign(s, finishing, id, " (where the result is written before it takes its name)");
+    }
+    // A result named *.xmf, or with a colon in its name, gets no sidecar (xdmf_unsupported).
+    const bool gets_sidecar = sidecar != out && out.filename().string().find(':') == std::string::npos;
+    if (gets_sidecar && (fs::exists(sidecar, ec) || fs::is_symlink(sidecar, ec))) {
+        if (!is_superball_sidecar(sidecar)) {
+            return refuse_foreign(s, sidecar, identify_file(sidecar), " (where the result's ParaView sidecar goes)");
+        }
+    }
+    return std::nullopt;
 }
 
 // Rank 0, for a fresh run, before anything is written: the output's directory exists
@@ -137,6 +193,7 @@ Decision check_writable(const fs::path& out, Decision d)
 
 Decision decide(const ExploreSettings& s, const fs::path& out, const Job& job)
 {
+    if (std::optional<Decision> d = check_companions(s, out)) return *d;
     std::error_code ec;
     const fs::path partial = layout::partial_path(out);
     if (fs::exists(partial, ec) || fs::is_symlink(partial, ec)) {

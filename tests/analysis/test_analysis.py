@@ -29,6 +29,7 @@ import region_map  # noqa: E402
 import superball_results  # noqa: E402
 import trajectory_plot  # noqa: E402
 from fixtures import CAPPED, INVALID, LEFT, MISSED, make_result  # noqa: E402
+from superball_testing import tile_boxes  # noqa: E402
 
 SCRIPTS = ("region_map.py", "trajectory_plot.py", "summary.py", "bifurcation_plot.py")
 BINARY = os.environ.get("SUPERBALL", "")
@@ -258,7 +259,7 @@ class RegionMapTest(ScriptTestCase):
         by_index = self.bare(result, "--slice", "U=2")
         self.assert_one_colour_per_key(by_index, colour_keys(counts, outcomes))
         with h5py.File(result, "r") as f:
-            value = f["axes/U"][2] + 0.01
+            value = f["U"][2] + 0.01
         np.testing.assert_array_equal(self.bare(result, "--slice", f"U={value!r}"), by_index)
         self.assertEqual(self.bare(result, "--slice", "xi=3").shape[:2], (GRID_3D["W"][2], GRID_3D["U"][2]))
         self.run_script("region_map.py", result, "--slice", "U=2", "--outcome")
@@ -338,7 +339,7 @@ class SummaryTest(ScriptTestCase):
             rng = np.random.default_rng(7)
             counts = np.minimum(rng.geometric(0.1, size=shape) - 1, max_bounces)
             outcome = np.where(counts == max_bounces, CAPPED, rng.choice([INVALID, LEFT, MISSED], size=shape))
-            return counts, outcome
+            return np.where(outcome == INVALID, 0, counts), outcome  # an invalid launch has no bounce
 
         return self.result(name, grid=GRID_3D, data=data, max_bounces=40, **options)
 
@@ -382,15 +383,115 @@ class SummaryTest(ScriptTestCase):
         result = self.result("wide.h5", max_bounces=70000)
         with h5py.File(result, "a") as f:
             self.assertEqual(f["wall_bounces"].dtype, np.uint32)
-            f.attrs["axis_names"] = "xi,W"
-            f.attrs["coordinates"] = np.bytes_(b"canonical")
+            f.attrs["coordinates"] = np.bytes_(b"canonical")  # an attribute the layout does not use: ignored
         summary = json.loads(self.run_script("summary.py", result, "--json").stdout)
         self.assertEqual(summary["axis_names"], ["xi", "W"])
         self.assertIn(70000, [r["wall_bounces"] for r in summary["wall_bounces"]])
+        # The layout has one spelling of axis_names, a list: a comma-separated text is refused.
+        with h5py.File(result, "a") as f:
+            f.attrs["axis_names"] = "xi,W"
+        process = self.run_script("summary.py", result, "--json", status=2)
+        self.assertIn("attribute axis_names is a text, not a list of texts", process.stderr)
 
     def test_missing_file(self):
         process = self.run_script("summary.py", self.path("nothing.h5"), status=2)
         self.assertIn("nothing.h5", process.stderr)
+
+
+class FileLayoutTest(ScriptTestCase):
+    """The fixtures are laid out as superball writes its files, and the scripts read that
+    layout as the binary does: partial files with their tiles not done masked, values
+    checked, the 0.1 layout refused with the binary's message."""
+
+    def kinds(self):
+        """One fixture of every kind make_result writes."""
+        return {
+            "2-D result": self.result("r2.h5"),
+            "3-D result": self.result("r3.h5", grid=GRID_3D),
+            "1-D result": self.result("r1.h5", grid={"xi": (0.0, 1.0, 50), "U": -1.0, "W": 0.5}),
+            "physical result": self.result("phys.h5", coordinates="physical",
+                                           grid={"x": (0.0, 0.05, 40), "u": -2.0, "v": 2.0, "omega": (-300.0, 300.0, 30)}),
+            "32-bit counts": self.result("wide.h5", max_bounces=70000),
+            "2-D partial": self.result("p2.h5", complete=False, tiles=4, tiles_done=1),
+            "3-D partial": self.result("p3.h5", grid=GRID_3D, complete=False, tiles=8, tiles_done=3),
+            "partial, no tile done": self.result("p0.h5", complete=False, tiles=6, tiles_done=0),
+        }
+
+    @unittest.skipUnless(HAVE_BINARY, "SUPERBALL does not name a built binary")
+    def test_superball_info_accepts_every_fixture_kind(self):
+        for kind, path in self.kinds().items():
+            with self.subTest(kind):
+                process = subprocess.run([BINARY, "info", path], capture_output=True, text=True, timeout=60)
+                self.assertEqual(process.returncode, 0, process.stderr)
+                partial = kind.endswith("partial") or "partial" in kind
+                self.assertIn("kind:        partial" if partial else "kind:        result", process.stdout)
+                with h5py.File(path, "r") as f:
+                    done = int(f["progress/tile_done"][()].sum()) if partial else None
+                    tiles = f["progress/tile_done"].size if partial else None
+                if partial:
+                    self.assertIn(f"complete:    no ({done} of {tiles} tiles done)", process.stdout)
+                self.run_script("summary.py", path, "--json")
+
+    def test_partial_file_reads_tiles_not_done_as_invalid(self):
+        result = self.result("part.h5", complete=False, tiles=4, tiles_done=1)
+        with h5py.File(result, "r+") as f:
+            # Tiles not done hold whatever the disk held: nonsense, never read.
+            tiles = tile_boxes(f["outcome"].shape, [int(t) for t in f.attrs["tile_shape"]])
+            for box in tiles[1:]:
+                f["outcome"][box] = 9
+                f["wall_bounces"][box] = 12345
+            done_points = f["outcome"][tiles[0]].size
+            stored = f["outcome"][tiles[0]]
+        process = self.run_script("summary.py", result, "--json")
+        summary = json.loads(process.stdout)
+        self.assertIn("warning", process.stderr)
+        self.assertIn("1 of 4 tiles done", process.stderr)
+        self.assertIs(summary["complete"], False)
+        invalid = summary["outcome"][INVALID]["points"]
+        self.assertEqual(invalid, summary["points"] - done_points + int((stored == INVALID).sum()))
+        self.assertNotIn(12345, [r["wall_bounces"] for r in summary["wall_bounces"]])
+        with superball_results.Result(result) as r:
+            counts, outcomes = r.read((slice(None), slice(None)))
+        self.assertTrue((outcomes[tiles[1]] == INVALID).all() and (counts[tiles[1]] == 0).all())
+
+    def test_values_are_checked_naming_the_object_and_the_point(self):
+        cases = [
+            ("outcome", (3, 4), 200, "/outcome holds 200 at (3, 4): outcome codes are 0 to 3"),
+            ("wall_bounces", (0, 2), 5, "/wall_bounces holds 5 at (0, 2) with outcome 0 (invalid), which allows 0"),
+            ("wall_bounces", (7, 9), 1001, "/wall_bounces holds 1001 at (7, 9) with outcome"),
+        ]
+        for dataset, at, value, message in cases:
+            with self.subTest(dataset=dataset, at=at):
+                result = self.result("bad.h5")
+                with h5py.File(result, "r+") as f:
+                    f[dataset][at] = value
+                for script in ("summary.py", "region_map.py"):
+                    process = self.run_script(script, result, status=2)
+                    self.assertIn(f"bad.h5: {message}", process.stderr)
+                    self.assertEqual(len(process.stderr.strip().splitlines()), 1, process.stderr)
+                if HAVE_BINARY:
+                    process = subprocess.run([BINARY, "info", result], capture_output=True, text=True, timeout=60)
+                    self.assertEqual(process.returncode, 2)
+                    self.assertIn(message, process.stderr)
+
+    def test_layout_of_superball_0_1_is_refused_as_the_binary_refuses_it(self):
+        path = self.path("old.h5")
+        with h5py.File(path, "w") as f:
+            f.create_dataset("wall_bounces", data=np.zeros((4, 3), np.uint16))
+            f.create_dataset("outcome", data=np.zeros((4, 3), np.uint8))
+            f.create_dataset("axes/xi", data=np.arange(4.0))
+            f.create_dataset("axes/W", data=np.arange(3.0))
+            f.create_dataset("progress/tile_done", data=np.ones(1, np.uint8))
+            f.attrs.update({"coordinates": "canonical", "axis_names": ["xi", "W"], "job_toml": "[model]\n",
+                            "software_version": "0.1.0", "complete": np.uint8(1), "max_bounces": np.uint32(10)})
+        message = (f"{path}: written by superball 0.1.0 in the layout before netCDF conventions, which this version "
+                   "does not read; run the job again with this version")
+        for script in ("summary.py", "region_map.py"):
+            self.assertIn(message, self.run_script(script, path, status=2).stderr)
+        if HAVE_BINARY:
+            process = subprocess.run([BINARY, "info", path], capture_output=True, text=True, timeout=60)
+            self.assertEqual(process.returncode, 2)
+            self.assertEqual(process.stderr.strip(), "superball info: " + message)
 
 
 class TrajectoryPlotTest(ScriptTestCase):

@@ -17,6 +17,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -24,6 +25,9 @@ import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+from superball_testing import tile_checksum  # noqa: E402
+
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 SOURCE_DIR = os.environ.get("SUPERBALL_SOURCE_DIR", os.path.join(HERE, os.pardir, os.pardir))
@@ -192,17 +196,21 @@ class Quickstart(unittest.TestCase):
                            text=True, env=mpi_env(), timeout=300)
         self.assertEqual(r.returncode, 1, r.stderr)
         partial = out + ".partial"
-        # Tiles done by the stopped run, and a few more copied from the complete result.
+        # Tiles done by the stopped run, and a few more copied from the complete result, each
+        # recorded with its checksum as the run records it (the readers check them).
         with h5py.File(self.result, "r") as full, h5py.File(partial, "r+") as f:
             th, tw = (int(t) for t in f.attrs["tile_shape"])
             tiles_per_row = -(-N // tw)
             done = f["progress/tile_done"][...]
+            sums = f["progress/tile_checksum"][...]
             for t in (0, 3, len(done) - 1):
                 i0, j0 = (t // tiles_per_row) * th, (t % tiles_per_row) * tw
                 box = (slice(i0, i0 + th), slice(j0, j0 + tw))
                 f["wall_bounces"][box] = full["wall_bounces"][box]
                 f["outcome"][box] = full["outcome"][box]
+                sums[t] = tile_checksum(f["wall_bounces"], f["outcome"], t, (i0, j0))
                 done[t] = 1
+            f["progress/tile_checksum"][...] = sums
             f["progress/tile_done"][...] = done
         points = 0
         for t in np.flatnonzero(done == 0):
