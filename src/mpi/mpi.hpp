@@ -50,13 +50,20 @@ using Getenv = std::function<const char*(const char* name)>;
 std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view user_params);
 
 // MPI_Init / MPI_Finalize for the lifetime of the object. One per process. With Open MPI,
-// sets the parameters of single_node_mca() first.
+// sets the parameters of single_node_mca() first. An isolated singleton also gets a session
+// directory of its own (orte_tmpdir_base, a fresh directory under $TMPDIR or /tmp, removed
+// after MPI_Finalize): isolated singletons all take the job family 0, so two started at the
+// same moment create and remove the same <tmp>/ompi.<host>.<uid>/jf.0 and one of them fails
+// in orte_init ("A call to mkdir was unable to create the desired directory", ompi#3818).
 class Environment {
 public:
     Environment();
     ~Environment();
     Environment(const Environment&) = delete;
     Environment& operator=(const Environment&) = delete;
+
+private:
+    std::string session_base_;  // the private session directory, or empty
 };
 
 // An MPI_Info object of hints (MPI-IO's, here), freed with the object.

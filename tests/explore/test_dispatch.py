@@ -166,6 +166,27 @@ class SingleNodeStartUp(unittest.TestCase):
         self.assertNotIn("component hnp", self.log([]))
         self.assertIn("component hnp", self.log([], OMPI_MCA_ess_singleton_isolated="0"))
 
+    def test_singletons_started_together_all_run(self):
+        """Isolated singletons share Open MPI's job family 0: without a session directory of
+        their own, one that removes <tmp>/ompi.*/jf.0 as it ends makes another's start fail.
+        Each gets its own under TMPDIR, gone when it ends."""
+        tmp = os.path.join(self.dir, "tmp")
+        os.makedirs(tmp)
+        env = env_without("OMPI_MCA_pml", "OMPI_MCA_ess_singleton_isolated", "OMPI_MCA_orte_tmpdir_base",
+                          HOME=self.dir, TMPDIR=tmp)
+        # Short runs (a job refused for its output, which exists) end while others start:
+        # the race is in the start and the end.
+        existing = os.path.join(self.dir, "exists.h5")
+        open(existing, "w").close()
+        for _ in range(5):
+            runs = [subprocess.Popen([superball_binary(), "explore", self.job, "-o", existing, "-q"], env=env,
+                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for i in range(8)]
+            for r in runs:
+                _, err = r.communicate(timeout=120)
+                self.assertEqual(r.returncode, 2, err)
+                self.assertIn("exists.h5", err)
+            self.assertEqual(os.listdir(tmp), [])
+
     def test_the_users_choice_stands(self):
         self.assertGreater(len(self.opened([], OMPI_MCA_pml="^ucx")), 1)
         self.assertGreater(len(self.opened([MPIEXEC, "-n", "2", "--oversubscribe", "--mca", "pml", "^ucx"])), 1)
