@@ -54,6 +54,15 @@ private:
     std::vector<Axis> axes_;     // the range axes, in result order
 };
 
+// A counting kernel: count_each(), count_each_simd() or count_each_on_plane().
+using CountKernel = void (*)(const StartsView&, const ModelMatrices&, std::uint32_t, std::span<std::uint32_t>,
+                             std::span<std::uint8_t>);
+
+// The kernel that counts `grid`'s points, given the one chosen for a run (scalar or
+// vectorised): count_each_on_plane() on a boundary plane. Every front end (explore, serve)
+// counts through this, so the same grid gives the same numbers everywhere.
+CountKernel kernel_for(const Grid& grid, CountKernel chosen);
+
 // The tiling of a new result: [run] tile_points, or a default from the grid size and the
 // rank count. With refinement the results depend on the tile shape (cells do not cross
 // tiles), so there the default ignores the rank count: any number of ranks gives the

@@ -159,12 +159,6 @@ double peak_rss_mib()
     return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
 
-CountKernel kernel_for(const Grid& grid, KernelChoice k)
-{
-    if (grid.on_boundary_plane()) return &count_each_on_plane;
-    return k == KernelChoice::scalar ? &count_each : &count_each_simd;
-}
-
 void broadcast(const mpi::Comm& comm, PartialLayout& l)
 {
     std::vector<std::uint64_t> v{l.counts_at, l.outcomes_at, l.done_at, l.checksums_at, l.count_bytes, l.chunk_points, l.tiles};
@@ -176,7 +170,11 @@ void broadcast(const mpi::Comm& comm, PartialLayout& l)
 class Work final : public TileWork {
 public:
     Work(const Job& job, const Grid& grid, TileWriter& writer, const Tiling& tiling, KernelChoice k)
-        : job_(job), grid_(grid), writer_(writer), tiling_(tiling), counter_(kernel_for(grid, k), job.max_bounces)
+        : job_(job),
+          grid_(grid),
+          writer_(writer),
+          tiling_(tiling),
+          counter_(kernel_for(grid, k == KernelChoice::scalar ? &count_each : &count_each_simd), job.max_bounces)
     {
     }
 

@@ -12,10 +12,6 @@
 
 namespace superball {
 
-// count_each() or count_each_simd().
-using CountKernel = void (*)(const StartsView&, const ModelMatrices&, std::uint32_t, std::span<std::uint32_t>,
-                             std::span<std::uint8_t>);
-
 // Runs `kernel` over `starts` in blocks, calling `serve` between blocks; in one call when
 // `serve` is empty (no rank is waiting to be served).
 void count_in_blocks(CountKernel kernel, const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
