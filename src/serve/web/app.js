@@ -35,6 +35,7 @@
   let map = null;
   let tiles = null;
   let marker = null;
+  let outline = null;
   let countRequest = null;
   let countTimer = null;
   let animation = null;
@@ -202,6 +203,9 @@
     writeControls();
     map.setMaxZoom(precisionZoom());
     tiles.setUrl(tileUrl());
+    if (outline) outline.remove();
+    outline = L.rectangle([[-TILE, 0], [0, TILE]], { color: "#fff", weight: 1, dashArray: "4 4", fill: false,
+                                                     interactive: false }).addTo(map);
     if (fit) map.fitBounds([[-TILE, 0], [0, TILE]], { animate: false });
     drawLegend();
   }
@@ -281,6 +285,7 @@
     const f = formatter();
     const s = startOf(c);
     const coords = AXES.map((a) => (a + "  ").slice(0, 3) + "= " + (a === fixedAxis() ? String(s[a]) : f(s[a])));
+    window.explorer.readoutStart = s;
     $("readout").textContent = coords.join("\n") + "\nN  = …";
     clearTimeout(countTimer);
     countTimer = setTimeout(() => readCount(s, coords), COUNT_DELAY_MS);
@@ -314,6 +319,7 @@
 
   async function onClick(ev) {
     const s = startOf(toCoords(ev.latlng));
+    window.explorer.trajectoryStart = s;
     if (marker) marker.remove();
     marker = L.circleMarker(ev.latlng, { radius: 5, color: "#fff", weight: 2, fillColor: "#d62728", fillOpacity: 1 }).addTo(map);
     const p = modelParams(new URLSearchParams());
@@ -468,9 +474,10 @@
       setWindow({ x_min: x0, x_max: x1, y_min: y0, y_max: y1 });
     });
     $("export").addEventListener("click", onExport);
+    // For tests and the console: the map, the view, and the starts of the readout and the
+    // trajectory.
+    window.explorer = { map, state, toCoords, readoutStart: null, trajectoryStart: null };
     refresh(true);
-    // For tests and the console: the map and the view.
-    window.explorer = { map, state, toCoords };
   }
 
   document.addEventListener("DOMContentLoaded", start);
