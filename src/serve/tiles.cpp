@@ -126,15 +126,18 @@ namespace {
 // unless given an error function: this one throws, which libpng allows for C++ callers
 // that do not return to it.
 struct PngWriter {
-    png_structp png = nullptr;
-    png_infop info = nullptr;
+    png_structp png;
+    png_infop info;
     std::string out;
 
     PngWriter()
+        : png(png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, &PngWriter::error, nullptr)),
+          info(png ? png_create_info_struct(png) : nullptr)
     {
-        png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, &PngWriter::error, nullptr);
-        if (png) info = png_create_info_struct(png);
-        if (!png || !info) throw std::runtime_error("libpng: cannot allocate a PNG writer");
+        if (!png || !info) {
+            png_destroy_write_struct(&png, &info);  // either may be null
+            throw std::runtime_error("libpng: cannot allocate a PNG writer");
+        }
     }
     ~PngWriter() { png_destroy_write_struct(&png, &info); }
     PngWriter(const PngWriter&) = delete;

@@ -40,7 +40,10 @@ QUICKSTART = dict(x="xi", x_min=0, x_max=1, y="W", y_min=-3, y_max=3, U=-1, e=0.
 OUTCOME_RGB = np.array([(153, 153, 153), (31, 119, 180), (255, 127, 14), (0, 0, 0)], dtype=np.uint8)
 # A launch that bounces for ever without dissipation (superball_testing.capped_job).
 CAPPED = dict(x="xi", x_min=0.24, x_max=0.26, y="W", y_min=-1.27, y_max=-1.23, U=-0.5, e=1, alpha=1)
-SERVER_TIMEOUT = 120
+# Under AddressSanitizer (tests/run's asan stage) counting is several times slower and
+# freed memory is held in quarantine: latencies are allowed this factor, memory not checked.
+SANITIZED = "ASAN_OPTIONS" in os.environ
+SLOWER = 10 if SANITIZED else 1
 
 
 def query(**params):
@@ -381,10 +384,10 @@ class LoadTest(unittest.TestCase):
             status, body = result["answer"]
             self.assertEqual(status, 503, body)
             self.assertIn("took longer than the server's time limit of 1 s", body["error"])
-            self.assertLess(result["seconds"], 3.0)
+            self.assertLess(result["seconds"], 1 + 2 * SLOWER)
             print(f"\nfast requests beside the slow one: {len(fast)}, at most {1e3 * max(fast):.0f} ms")
             self.assertGreater(len(fast), 2)
-            self.assertLess(max(fast), 0.5, fast)
+            self.assertLess(max(fast), 0.5 * SLOWER, fast)
             self.assertEqual(server.json("/api/info")[1]["stats"]["timed_out"], 1)
 
     def test_abandoned_request_is_dropped(self):
@@ -405,7 +408,7 @@ class LoadTest(unittest.TestCase):
             started = time.monotonic()
             status, _ = server.json("/api/region?" + query(**QUICKSTART, nx=256, ny=256))
             self.assertEqual(status, 200)
-            self.assertLess(time.monotonic() - started, 1.0)
+            self.assertLess(time.monotonic() - started, 1.0 * SLOWER)
 
     def test_concurrent_clients(self):
         clients, requests = 16, 50
@@ -441,7 +444,8 @@ class LoadTest(unittest.TestCase):
             self.assertEqual(len(latencies), clients * requests)
             self.assertLess(wall, 60)
             # Memory flat: a second round of the same load leaves the server where the first did.
-            self.assertLess(again - after, 8 * 1024, (before, after, again))
+            if not SANITIZED:
+                self.assertLess(again - after, 8 * 1024, (before, after, again))
             stats = server.json("/api/info")[1]["stats"]
             self.assertEqual((stats["timed_out"], stats["refused"], stats["pending"]), (0, 0, 0))
 
