@@ -28,6 +28,17 @@ private:
 
 }  // namespace
 
+std::string model_json(const Model& m)
+{
+    std::string out = "{";
+    Fields(out)
+        .number("e_wall", m.wall.e)
+        .number("alpha_wall", m.wall.alpha)
+        .number("e_floor", m.floor.e)
+        .number("alpha_floor", m.floor.alpha);
+    return out + "}";
+}
+
 std::string count_json(const BounceCount& r, const CanonicalState<double>& start)
 {
     std::string out = "{";
@@ -47,13 +58,7 @@ std::string trajectory_json(const Trajectory& tr, const Start& start, const Mode
     Fields(out).text("units", start.physical ? "SI" : "dimensionless (v0 = g = radius = 1)");
     out += ",\n  ";
     Fields(out).number("g", start.frame.g).number("radius", a);
-    out += ",\n  \"model\": {";
-    Fields(out)
-        .number("e_wall", m.wall.e)
-        .number("alpha_wall", m.wall.alpha)
-        .number("e_floor", m.floor.e)
-        .number("alpha_floor", m.floor.alpha);
-    out += "},\n  \"start\": {";
+    out += ",\n  \"model\": " + model_json(m) + ",\n  \"start\": {";
     Fields(out).number("xi", start.canonical.xi).number("U", start.canonical.U).number("W", start.canonical.W);
     out += "},\n  ";
     Fields(out)

@@ -11,6 +11,9 @@
 
 namespace superball {
 
+// {"e_wall": ..., "alpha_wall": ..., "e_floor": ..., "alpha_floor": ...}
+std::string model_json(const Model& m);
+
 // {"wall_bounces": N, "outcome": "left", "xi": ..., "U": ..., "W": ...}
 std::string count_json(const BounceCount& r, const CanonicalState<double>& start);
 

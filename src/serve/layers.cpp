@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "core/input.hpp"
+#include "core/report.hpp"
 
 namespace superball::serve {
 
@@ -60,16 +61,15 @@ std::string Layer::json(std::size_t index) const
         const Coordinate& c = job_.grid[k];
         out += (k ? ", " : "") + quote(c.name) + ": " + (c.is_range() ? range_json(*c.range) : format_double(*c.fixed));
     }
-    const Model& m = job_.model;
-    out += "}, \"model\": {\"e_wall\": " + format_double(m.wall.e) + ", \"alpha_wall\": " + format_double(m.wall.alpha) +
-           ", \"e_floor\": " + format_double(m.floor.e) + ", \"alpha_floor\": " + format_double(m.floor.alpha) + "}";
+    out += "}, \"model\": " + model_json(job_.model);
     out += ", \"max_bounces\": " + std::to_string(job_.max_bounces);
-    // The first two axes across and up, the third (if any) at its middle sample.
+    // The first axis across and the last up (for a volume: xi and W, the slices of the
+    // quickstart job), the third coordinate fixed (a volume's middle axis at its middle sample).
     const auto axis = [&](std::size_t d) { return std::string(axis_names[static_cast<std::size_t>(dims_[d])]); };
-    const int fixed = 3 - dims_[0] - dims_[1];
+    const int fixed = 3 - dims_.front() - dims_.back();
     const Coordinate& f = job_.grid[static_cast<std::size_t>(fixed)];
     const double value = f.is_range() ? f.range->sample(f.range->n / 2) : *f.fixed;
-    out += ", \"view\": {\"x\": " + quote(axis(0)) + ", \"y\": " + quote(axis(1)) + ", \"fixed\": " +
+    out += ", \"view\": {\"x\": " + quote(axis(0)) + ", \"y\": " + quote(axis(dims_.size() - 1)) + ", \"fixed\": " +
            quote(axis_names[static_cast<std::size_t>(fixed)]) + ", \"value\": " + format_double(value) + "}}";
     return out;
 }

@@ -140,12 +140,6 @@ void answer_error(httplib::Response& res, int status, const std::string& message
     answer_json(res, status, "{\"error\": " + quote(message) + "}\n");
 }
 
-std::string model_json(const Model& m)
-{
-    return "{\"e_wall\": " + format_double(m.wall.e) + ", \"alpha_wall\": " + format_double(m.wall.alpha) +
-           ", \"e_floor\": " + format_double(m.floor.e) + ", \"alpha_floor\": " + format_double(m.floor.alpha) + "}";
-}
-
 std::string region_json(const View& v, const RegionCounts& r)
 {
     const auto name = [](int k) { return quote(axis_names[static_cast<std::size_t>(k)]); };

@@ -262,6 +262,28 @@ class ApiTest(unittest.TestCase):
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn(bogus, r.stderr)
 
+    def test_volume_layer_shows_the_slice_holding_the_fixed_value(self):
+        job = self.path("volume.toml")
+        with open(job, "w") as f:
+            f.write("[model]\ne = 0.9\nalpha = 0.9\n\n[grid]\nxi = { min = 0.0, max = 1.0, n = 16 }\n"
+                    "U = { min = -2.0, max = -0.5, n = 5 }\nW = { min = -3.0, max = 3.0, n = 12 }\n\n"
+                    "[run]\nmax_bounces = 1000\n")
+        result = self.path("volume.h5")
+        r = run("explore", job, "-o", result, "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with h5py.File(result, "r") as f:
+            outcomes = f["outcome"][()]  # (xi, U, W)
+        with Server(result, "--threads", "2") as server:
+            layer = server.json("/api/info")[1]["layers"][0]
+            self.assertEqual(layer["view"], {"x": "xi", "y": "W", "fixed": "U", "value": -1.25})
+            # U = -1.2 lies in the cell of the sample -1.25, [-1.4, -1.1]; one pixel per sample.
+            window = dict(QUICKSTART, U=-1.2, x_max=16, y_max=125, show="outcome")
+            status, _, body = server.get("/tile/0/0/0.png?" + query(**window, layer=0))
+            self.assertEqual(status, 200, body)
+            rgba = np.array(Image.open(io.BytesIO(body)).convert("RGBA"))
+            pixels = rgba[256 - 12:, :16][::-1].transpose(1, 0, 2)  # (xi, W)
+            np.testing.assert_array_equal(pixels[:, :, :3], OUTCOME_RGB[outcomes[:, 2, :]])
+
     def test_bad_requests(self):
         cases = [
             ("/api/count?" + query(xi=0.05, U=-1, W=-2, e=0.9, alpah=0.9), 400,
