@@ -166,3 +166,65 @@ def client_results(directory, kinds, names=None):
         assert r.returncode == 0, f"{' '.join(cmd)}\n{r.stderr}"
         paths[kind] = out
     return paths
+
+
+class Server:
+    """`superball serve ARGS... --port 0` started for a test, on a free loopback port (the
+    server picks it and prints its URL); a context manager that stops it with SIGTERM and
+    checks that it exits cleanly."""
+
+    def __init__(self, *args, binary=None):
+        import select
+        self.process = subprocess.Popen([binary or superball_binary(), "serve", "--port", "0", *args],
+                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        ready, _, _ = select.select([self.process.stdout], [], [], 60)
+        line = self.process.stdout.readline() if ready else ""
+        if "http://" not in line:
+            self.process.kill()
+            raise AssertionError(f"superball serve printed no URL: {line!r} {self.process.stderr.read()}")
+        self.url = line.split()[2]  # "superball serve: URL (Ctrl-C to stop)"
+
+    def get(self, path, timeout=60):
+        """(status, headers, body bytes) of GET url + path."""
+        import urllib.error
+        import urllib.request
+        try:
+            with urllib.request.urlopen(self.url + path.lstrip("/"), timeout=timeout) as r:
+                return r.status, dict(r.headers), r.read()
+        except urllib.error.HTTPError as e:
+            return e.code, dict(e.headers), e.read()
+
+    def json(self, path, timeout=60):
+        """(status, decoded JSON body) of GET url + path."""
+        import json
+        status, _, body = self.get(path, timeout)
+        return status, json.loads(body)
+
+    def rss_kib(self):
+        """The server's resident memory now and at its peak (VmRSS, VmHWM), in KiB."""
+        with open(f"/proc/{self.process.pid}/status") as f:
+            fields = dict(line.split(":", 1) for line in f)
+        return int(fields["VmRSS"].split()[0]), int(fields["VmHWM"].split()[0])
+
+    def stop(self):
+        import signal
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGTERM)
+        try:
+            self.process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+            raise AssertionError("superball serve did not stop within 30 s of SIGTERM")
+        stderr = self.process.stderr.read()
+        self.process.stdout.close()
+        self.process.stderr.close()
+        return self.process.returncode, stderr
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        code, stderr = self.stop()
+        if exc[0] is None:
+            assert code == 0, f"superball serve exited with {code}: {stderr}"

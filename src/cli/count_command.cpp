@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "core/count.hpp"
+#include "core/report.hpp"
 #include "options.hpp"
 
 namespace superball::cli {
@@ -35,8 +36,7 @@ Runner add_count_command(CLI::App& app)
         const Start start = resolve_start(opt->start);
         const BounceCount r = count(start.canonical, model, opt->max_bounces);
         if (opt->json) {
-            fmt::print("{{\"wall_bounces\": {}, \"outcome\": \"{}\", \"xi\": {}, \"U\": {}, \"W\": {}}}\n", r.wall_bounces,
-                       name(r.outcome), start.canonical.xi, start.canonical.U, start.canonical.W);
+            fmt::print("{}", count_json(r, start.canonical));
         } else {
             fmt::print("{} wall bounce{}, outcome {}\n", r.wall_bounces, r.wall_bounces == 1 ? "" : "s", name(r.outcome));
         }

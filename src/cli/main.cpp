@@ -76,7 +76,7 @@ int main(int argc, char** argv)
     std::map<const CLI::App*, cli::Runner> runners;
     for (auto add : {cli::add_explore_command, cli::add_count_command, cli::add_trajectory_command,
                      cli::add_info_command, cli::add_analyse_command, cli::add_fixed_points_command,
-                     cli::add_continue_command}) {
+                     cli::add_continue_command, cli::add_serve_command}) {
         auto run = add(app);
         runners.emplace(app.get_subcommands({}).back(), std::move(run));
     }

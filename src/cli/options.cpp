@@ -1,6 +1,5 @@
 #include "options.hpp"
 
-#include <cmath>
 #include <memory>
 #include <stdexcept>
 
@@ -61,60 +60,6 @@ void write_output(const std::string& path, const std::function<void(std::FILE*)>
     if (std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + path);
 }
 
-namespace {
-
-double require(const std::optional<double>& value, std::string_view key, std::string_view kind)
-{
-    if (!value) throw InputError(flag_spelling(key) + " is not set: a " + std::string(kind) + " start needs it");
-    if (!std::isfinite(*value)) throw InputError(flag_spelling(key) + " = " + format_double(*value) + " is not a finite number");
-    return *value;
-}
-
-void check(bool ok, std::string_view key, double value, std::string_view accepted)
-{
-    if (!ok) {
-        throw InputError(flag_spelling(key) + " = " + format_double(value) + " is not a launch toward the wall: accepted " +
-                         std::string(accepted));
-    }
-}
-
-}  // namespace
-
-Start resolve_start(const StartFlags& in)
-{
-    const bool any_canonical = in.xi || in.U || in.W;
-    const bool any_physical = in.x || in.u || in.v || in.omega;
-    if (any_canonical && any_physical) {
-        throw InputError("give either a canonical start (--xi --U --W) or a physical one (--x --u --v --omega), not both");
-    }
-    if (!any_canonical && !any_physical) {
-        throw InputError("no start point: give --xi --U --W (canonical) or --x --u --v --omega (physical)");
-    }
-    Start s;
-    if (any_canonical) {
-        if (in.g || in.radius) throw InputError("--g and --radius apply to physical starts only");
-        s.canonical = {require(in.xi, "xi", "canonical"), require(in.U, "U", "canonical"), require(in.W, "W", "canonical")};
-        check(s.canonical.xi > 0.0, "xi", s.canonical.xi, "xi > 0 (xi >= 1 misses the wall)");
-        check(s.canonical.U < 0.0, "U", s.canonical.U, "U < 0");
-        s.frame = {1.0, 1.0};
-        s.state = to_physical(s.canonical, 1.0, 1.0);
-        return s;
-    }
-    s.physical = true;
-    s.frame.g = in.g.value_or(s.frame.g);
-    s.frame.radius = in.radius.value_or(s.frame.radius);
-    if (!(std::isfinite(s.frame.g) && s.frame.g > 0.0))
-        throw InputError("--g = " + format_double(s.frame.g) + " is out of range: accepted g > 0");
-    if (!(std::isfinite(s.frame.radius) && s.frame.radius > 0.0))
-        throw InputError("--radius = " + format_double(s.frame.radius) + " is out of range: accepted radius > 0");
-    const double omega = require(in.omega, "omega", "physical");
-    s.state = {require(in.x, "x", "physical"), require(in.u, "u", "physical"), require(in.v, "v", "physical"),
-               omega * s.frame.radius};
-    check(s.state.x > 0.0, "x", s.state.x, "x > 0");
-    check(s.state.u < 0.0, "u", s.state.u, "u < 0");
-    check(s.state.v > 0.0, "v", s.state.v, "v > 0");
-    s.canonical = to_canonical(s.state, s.frame.g);
-    return s;
-}
+Start resolve_start(const StartFlags& in) { return superball::resolve_start(in, flag_spelling); }
 
 }  // namespace superball::cli

@@ -18,24 +18,11 @@ std::string flag_spelling(std::string_view key);
 
 void add_model_flags(CLI::App& app, ModelInput& in);
 
-struct StartFlags {
-    std::optional<double> xi, U, W;                // canonical
-    std::optional<double> x, u, v, omega, g, radius;  // physical
-};
+using StartFlags = StartInput;
 
 void add_start_flags(CLI::App& app, StartFlags& in);
 
-// A start point as the user gave it. Canonical starts are also given as the physical
-// representative with v = 1 in units where g = 1 and radius = 1 (so omega = W).
-struct Start {
-    bool physical = false;
-    CanonicalState<double> canonical{};
-    PhysicalState<double> state{};
-    Frame frame{};
-};
-
-// Throws InputError naming the flag when the start is incomplete, mixed or not a launch
-// toward the wall.
+// resolve_start() with the flags' spelling.
 Start resolve_start(const StartFlags& in);
 
 void add_max_bounces_flag(CLI::App& app, std::uint32_t& max_bounces);

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "core/report.hpp"
 #include "core/trajectory.hpp"
 #include "options.hpp"
 
@@ -36,36 +37,6 @@ void write_csv(std::FILE* f, const Trajectory& tr, double radius)
     }
 }
 
-void write_json(std::FILE* f, const Trajectory& tr, const Start& start, const Model& m)
-{
-    const double a = start.frame.radius;
-    fmt::print(f, "{{\n  \"units\": \"{}\",\n", start.physical ? "SI" : "dimensionless (v0 = g = radius = 1)");
-    fmt::print(f, "  \"g\": {}, \"radius\": {},\n", start.frame.g, a);
-    fmt::print(f, "  \"model\": {{\"e_wall\": {}, \"alpha_wall\": {}, \"e_floor\": {}, \"alpha_floor\": {}}},\n", m.wall.e,
-               m.wall.alpha, m.floor.e, m.floor.alpha);
-    fmt::print(f, "  \"start\": {{\"xi\": {}, \"U\": {}, \"W\": {}}},\n", start.canonical.xi, start.canonical.U,
-               start.canonical.W);
-    fmt::print(f, "  \"wall_bounces\": {}, \"outcome\": \"{}\", \"events_truncated\": {},\n  \"events\": [",
-               tr.result.wall_bounces, name(tr.result.outcome), tr.truncated);
-    const char* sep = "\n";
-    for (const Event& e : tr.events) {
-        fmt::print(f,
-                   "{}    {{\"event\": \"{}\", \"wall_bounces\": {}, \"t\": {}, \"x\": {}, \"y\": {}, \"u_in\": {}, "
-                   "\"v_in\": {}, \"omega_in\": {}, \"u\": {}, \"v\": {}, \"omega\": {}}}",
-                   sep, name(e.kind), e.wall_bounces, e.t, e.x, e.y, e.before.u, e.before.v, e.before.W / a, e.after.u,
-                   e.after.v, e.after.W / a);
-        sep = ",\n";
-    }
-    fmt::print(f, "\n  ],\n  \"path\": [");
-    sep = "\n";
-    for (const PathPoint& p : tr.path) {
-        fmt::print(f, "{}    {{\"segment\": {}, \"t\": {}, \"x\": {}, \"y\": {}, \"u\": {}, \"v\": {}}}", sep, p.segment, p.t,
-                   p.x, p.y, p.u, p.v);
-        sep = ",\n";
-    }
-    fmt::print(f, "\n  ]\n}}\n");
-}
-
 }  // namespace
 
 Runner add_trajectory_command(CLI::App& app)
@@ -91,7 +62,7 @@ Runner add_trajectory_command(CLI::App& app)
         const Trajectory tr = trajectory(start.state, model, start.frame.g, opt->max_bounces, opt->samples);
         write_output(opt->output, [&](std::FILE* f) {
             if (opt->format == "json") {
-                write_json(f, tr, start, model);
+                fmt::print(f, "{}", trajectory_json(tr, start, model));
             } else {
                 write_csv(f, tr, start.frame.radius);
             }

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "model.hpp"
+#include "state.hpp"
 
 namespace superball {
 
@@ -29,6 +30,26 @@ using KeySpelling = std::function<std::string(std::string_view key)>;
 
 // Throws InputError if a coefficient is missing or out of its physical range.
 Model resolve_model(const ModelInput& in, const KeySpelling& spell);
+
+// A start point as given: canonical (xi, U, W) or physical (x, u, v, omega, with g and
+// radius defaulting to Frame's).
+struct StartInput {
+    std::optional<double> xi, U, W;
+    std::optional<double> x, u, v, omega, g, radius;
+};
+
+// A start point resolved. Canonical starts are also given as the physical representative
+// with v = 1 in units where g = 1 and radius = 1 (so omega = W).
+struct Start {
+    bool physical = false;
+    CanonicalState<double> canonical{};
+    PhysicalState<double> state{};
+    Frame frame{};
+};
+
+// Throws InputError naming the key when the start is incomplete, mixed or not a launch
+// toward the wall.
+Start resolve_start(const StartInput& in, const KeySpelling& spell);
 
 // Shortest text that reads back as the same double (for messages and attributes).
 std::string format_double(double x);

@@ -54,6 +54,11 @@ Tiling default_tiling(const Job& job, int ranks)
     return Tiling(shape, default_tile_shape(shape, points));
 }
 
+CountKernel kernel_for(const Grid& grid, CountKernel chosen)
+{
+    return grid.on_boundary_plane() ? &count_each_on_plane : chosen;
+}
+
 bool Grid::on_boundary_plane() const
 {
     if (job_.coordinates != Coordinates::canonical) return false;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/count.hpp"
+#include "core/kernels.hpp"
 #include "job.hpp"
 #include "tiles.hpp"
 
@@ -53,6 +54,11 @@ private:
     std::vector<double> fixed_;  // every coordinate; ranges overwritten per point
     std::vector<Axis> axes_;     // the range axes, in result order
 };
+
+// The kernel that counts `grid`'s points, given the one chosen for a run (a variant of
+// core/kernels.hpp): count_each_on_plane() on a boundary plane. Every front end (explore, serve)
+// counts through this, so the same grid gives the same numbers everywhere.
+CountKernel kernel_for(const Grid& grid, CountKernel chosen);
 
 // The tiling of a new result: [run] tile_points, or a default from the grid size and the
 // rank count. With refinement the results depend on the tile shape (cells do not cross

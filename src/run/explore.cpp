@@ -215,11 +215,6 @@ double peak_rss_mib()
     return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
 
-CountKernel kernel_for(const Grid& grid, CountKernel k)
-{
-    return grid.on_boundary_plane() ? &count_each_on_plane : k;
-}
-
 void broadcast(const mpi::Comm& comm, PartialLayout& l)
 {
     std::vector<std::uint64_t> v{l.counts_at, l.outcomes_at, l.done_at, l.checksums_at, l.count_bytes, l.chunk_points, l.tiles};

@@ -1,0 +1,162 @@
+// Drives the explorer's page in Debian's chromium, headless, through the DevTools protocol
+// (puppeteer-core): opens it, pans and zooms the map, reads the cursor readout, clicks a
+// launch and waits for its trajectory, exports the view, saves a screenshot. Prints what it
+// saw as JSON for tests/browser/test_browser.py, which checks it against the command line.
+//
+//   node page_test.mjs URL SCREENSHOT.png
+//
+// Exit status 1 with a message when the page does not behave.
+import fs from "node:fs";
+import os from "node:os";
+import path from "node:path";
+import puppeteer from "puppeteer-core";
+
+const [url, screenshot] = process.argv.slice(2);
+const CHROMIUM = process.env.CHROMIUM || "/usr/bin/chromium";
+const TIMEOUT_MS = 30000;
+
+function check(ok, what) {
+  if (!ok) throw new Error(what);
+}
+
+// The quickstart view (jobs/quickstart.toml's window).
+const view = new URLSearchParams({ x: "xi", y: "W", fixed: "-1", x_min: "0", x_max: "1", y_min: "-3", y_max: "3",
+                                   e: "0.9", alpha: "0.9", max_bounces: "1000" });
+
+const profile = fs.mkdtempSync(path.join(os.tmpdir(), "superball-chromium-"));
+// Headless as root needs --no-sandbox; the machine's network is closed, so every
+// background connection Chromium would try is turned off (NOTES.md).
+const browser = await puppeteer.launch({
+  executablePath: CHROMIUM,
+  headless: true,
+  userDataDir: profile,
+  args: ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
+         "--disable-sync", "--no-first-run", "--disable-default-apps", "--disable-extensions"],
+});
+const report = { errors: [] };
+try {
+  const page = await browser.newPage();
+  page.setDefaultTimeout(TIMEOUT_MS);
+  await page.setViewport({ width: 1280, height: 800 });
+  page.on("pageerror", (e) => report.errors.push("page error: " + e.message));
+  // HTTP errors are reported by URL (below), not by the console's copy of them.
+  page.on("console", (m) => {
+    if (m.type() === "error" && !m.text().startsWith("Failed to load resource")) report.errors.push("console: " + m.text());
+  });
+  // The cursor over xi <= 0 or U >= 0 is over no launch: the readout shows /api/count's 400
+  // message there. Any other HTTP error is the page's fault.
+  page.on("response", (r) => {
+    if (r.status() >= 400 && !(r.status() === 400 && r.url().includes("/api/count?"))) {
+      report.errors.push("HTTP " + r.status() + ": " + r.url());
+    }
+  });
+  page.on("requestfailed", (r) => {
+    // Leaflet drops tiles it no longer needs; the browser reports them as aborted.
+    if (!(r.url().includes("/tile/") && r.failure()?.errorText === "net::ERR_ABORTED")) {
+      report.errors.push("request failed: " + r.url() + " " + r.failure()?.errorText);
+    }
+  });
+
+  const tilesLoaded = async (zoom) => {
+    await page.waitForNetworkIdle({ idleTime: 300 });
+    return page.evaluate((z) => {
+      const imgs = [...document.querySelectorAll(".leaflet-tile-container img")];
+      const at = imgs.filter((i) => i.src.includes(`/tile/${z}/`));
+      return { loaded: at.filter((i) => i.classList.contains("leaflet-tile-loaded") && i.naturalWidth === 256).length,
+               all: at.length };
+    }, zoom);
+  };
+  const mapState = () => page.evaluate(() => {
+    const m = window.explorer.map;
+    return { zoom: m.getZoom(), center: m.getCenter() };
+  });
+
+  await page.goto(url + "#" + view.toString(), { waitUntil: "networkidle0" });
+  await page.waitForFunction(() => window.explorer && window.explorer.map);
+  const first = await mapState();
+  report.initial = { ...first, tiles: await tilesLoaded(first.zoom) };
+  check(report.initial.tiles.loaded > 0 && report.initial.tiles.loaded === report.initial.tiles.all,
+        "tiles did not load: " + JSON.stringify(report.initial.tiles));
+  const mapBox = await (await page.$("#map")).boundingBox();
+
+  // Pan toward the structure near the wall: drag the map 200 px right and 150 px up.
+  const cx = mapBox.x + mapBox.width / 2, cy = mapBox.y + mapBox.height / 2;
+  await page.mouse.move(cx, cy);
+  await page.mouse.down();
+  for (let k = 1; k <= 10; ++k) await page.mouse.move(cx + 20 * k, cy - 15 * k);
+  await page.mouse.up();
+  const panned = await mapState();
+  report.pan = { before: first.center, after: panned.center, scale: Math.pow(2, panned.zoom) };
+
+  // Zoom in twice with the control, with the wheel, then out with the control to zoom 3.
+  for (let k = 0; k < 2; ++k) {
+    await page.click(".leaflet-control-zoom-in");
+    await page.waitForFunction((z) => window.explorer.map.getZoom() === z, {}, first.zoom + k + 1);
+  }
+  await page.mouse.move(cx + 100, cy + 80);
+  await page.mouse.wheel({ deltaY: -100 });
+  await page.waitForFunction((z) => window.explorer.map.getZoom() > z, {}, first.zoom + 2);
+  const wheeled = (await mapState()).zoom;
+  for (let z = wheeled - 1; z >= first.zoom + 2; --z) {
+    await page.click(".leaflet-control-zoom-out");
+    await page.waitForFunction((z) => window.explorer.map.getZoom() === z, {}, z);
+  }
+  const zoomed = await mapState();
+  report.zoom = { before: first.zoom, wheeled, after: zoomed.zoom, tiles: await tilesLoaded(zoomed.zoom) };
+  check(report.zoom.tiles.loaded > 0 && report.zoom.tiles.loaded === report.zoom.tiles.all,
+        "zoomed tiles did not load: " + JSON.stringify(report.zoom.tiles));
+
+  // Cursor readout over a launch near the wall.
+  const pointOf = (xi, W) => page.evaluate((xi, W) => {
+    const s = window.explorer.state, m = window.explorer.map;
+    const latlng = L.latLng(((W - s.y_max) / (s.y_max - s.y_min)) * 256, ((xi - s.x_min) / (s.x_max - s.x_min)) * 256);
+    return m.latLngToContainerPoint(latlng);
+  }, xi, W);
+  const zoomView = await page.evaluate(() => {
+    const b = window.explorer.map.getBounds(), c = window.explorer.toCoords;
+    return { sw: c(b.getSouthWest()), ne: c(b.getNorthEast()) };
+  });
+  report.visible = zoomView;
+  const probe = { xi: zoomView.sw.x + 0.3 * (zoomView.ne.x - zoomView.sw.x),
+                  W: zoomView.sw.y + 0.4 * (zoomView.ne.y - zoomView.sw.y) };
+  const p = await pointOf(probe.xi, probe.W);
+  await page.mouse.move(mapBox.x + p.x, mapBox.y + p.y);
+  await page.waitForFunction(() => /N  = \d+ wall bounce/.test(document.getElementById("readout").textContent));
+  report.readout = {
+    text: await page.$eval("#readout", (e) => e.textContent),
+    start: await page.evaluate(() => window.explorer.readoutStart),
+  };
+
+  // Click: the trajectory is drawn and the ball moves.
+  const q = await pointOf(zoomView.sw.x + 0.2 * (zoomView.ne.x - zoomView.sw.x),
+                          zoomView.sw.y + 0.3 * (zoomView.ne.y - zoomView.sw.y));
+  await page.mouse.click(mapBox.x + q.x, mapBox.y + q.y);
+  await page.waitForFunction(() => /wall bounce/.test(document.getElementById("trajectory-info").textContent));
+  const ball = () => page.$eval("#trajectory .ball", (b) => [Number(b.getAttribute("cx")), Number(b.getAttribute("cy"))]);
+  const b0 = await ball();
+  await new Promise((r) => setTimeout(r, 400));
+  const b1 = await ball();
+  report.trajectory = {
+    info: await page.$eval("#trajectory-info", (e) => e.textContent),
+    start: await page.evaluate(() => window.explorer.trajectoryStart),
+    path_points: await page.$eval("#trajectory .path", (e) => e.getAttribute("points").trim().split(/\s+/).length),
+    wall_marks: await page.$$eval("#trajectory .impact", (e) => e.length),
+    ball: [b0, b1],
+  };
+
+  // Export the visible part as a job.
+  await page.click("#export");
+  await page.waitForFunction(() => !document.getElementById("job-text").hidden);
+  report.job = await page.$eval("#job-text", (e) => e.value);
+  report.message = await page.$eval("#message", (e) => e.textContent);
+
+  // The screenshot: the map, and the panel from its top (readout, trajectory, view).
+  await page.$eval("#panel", (e) => { e.scrollTop = 0; });
+  await page.mouse.move(mapBox.x + p.x, mapBox.y + p.y);
+  await page.waitForFunction(() => /N  = \d+ wall bounce/.test(document.getElementById("readout").textContent));
+  await page.screenshot({ path: screenshot });
+} finally {
+  await browser.close();
+  fs.rmSync(profile, { recursive: true, force: true });
+}
+console.log(JSON.stringify(report, null, 1));
