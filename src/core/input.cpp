@@ -82,7 +82,12 @@ Start resolve_start(const StartInput& in, const KeySpelling& spell)
 {
     const auto keys = [&](std::initializer_list<std::string_view> names) {
         std::string out;
-        for (const std::string_view n : names) out += (out.empty() ? "" : " ") + spell(n);
+        for (const std::string_view n : names) {
+            // Two appends: GCC 12 warns (-Wrestrict, a false positive, GCC bug 105329) on
+            // `"literal" + std::string` inlined here.
+            if (!out.empty()) out += ' ';
+            out += spell(n);
+        }
         return out;
     };
     const std::string canonical = keys({"xi", "U", "W"}), physical = keys({"x", "u", "v", "omega"});

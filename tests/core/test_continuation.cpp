@@ -222,8 +222,11 @@ TEST(Continuation, ElasticFamilyBranchPointWhereTheDissipativeBranchAttaches)
     const Branch b = branch_of({0.25, -0.5, -1.25}, elastic, Parameter::e, 1, 0.5, 1.0);
     const auto bp = events_of(b, Event::branch_point);
     ASSERT_EQ(bp.size(), 1u);
+    // At a branch point the corrector's matrix is singular: the point is located to about
+    // the square root of the rounding error (the AVX-512 build of Eigen's LU puts e at
+    // 1 + 2.3e-8, the portable one within 1e-8), not to the corrector's tolerance.
     EXPECT_NEAR(bp[0].point.U, -1.0 / 3.0, 1e-7);
-    EXPECT_NEAR(bp[0].parameter, 1.0, 1e-8);
+    EXPECT_NEAR(bp[0].parameter, 1.0, 1e-7);
     EXPECT_EQ(event_sequence(b), (std::vector<Event>{Event::boundary, Event::branch_point, Event::boundary}));
     for (const double d : {1e-3, 1e-4}) {
         const auto c = reference_cycle(bp[0].point, Model::uniform(1.0 - d, 1.0), Parameter::e, 1.0 - d, 1,
