@@ -253,19 +253,32 @@ public:
 
     std::vector<TileReport> flush() override { return writer_.flush(); }
 
-    // Four partial histograms: increments of one counter would wait for each other.
+    // The four codes from three sums the compiler vectorises (bit 0, bit 1, both bits):
+    // 16 bytes or more per instruction instead of a counter increment per point, which
+    // was a third of a run's time outside the kernel on the benchmark slice.
     void add_to_histogram(std::span<const std::uint8_t> outcomes)
     {
-        std::uint64_t h[4][outcome_count]{};
-        std::size_t i = 0;
-        for (; i + 4 <= outcomes.size(); i += 4) {
-            ++h[0][outcomes[i]];
-            ++h[1][outcomes[i + 1]];
-            ++h[2][outcomes[i + 2]];
-            ++h[3][outcomes[i + 3]];
+        static_assert(outcome_count == 4, "two bits per outcome code");
+        std::uint64_t bit0 = 0, bit1 = 0, both = 0;
+        // Blocks of at most 255 points: each sum fits the 8-bit lanes it is gathered in.
+        for (std::size_t i = 0; i < outcomes.size(); i += 255) {
+            const std::size_t end = std::min(outcomes.size(), i + 255);
+            std::uint8_t b0 = 0, b1 = 0, bb = 0;
+            for (std::size_t j = i; j < end; ++j) {
+                const std::uint8_t o = outcomes[j];
+                b0 = static_cast<std::uint8_t>(b0 + (o & 1u));
+                b1 = static_cast<std::uint8_t>(b1 + ((o >> 1) & 1u));
+                bb = static_cast<std::uint8_t>(bb + (o & (o >> 1) & 1u));
+            }
+            bit0 += b0;
+            bit1 += b1;
+            both += bb;
         }
-        for (; i < outcomes.size(); ++i) ++h[0][outcomes[i]];
-        for (std::size_t o = 0; o < outcome_count; ++o) histogram[o] += h[0][o] + h[1][o] + h[2][o] + h[3][o];
+        const std::uint64_t n = outcomes.size();
+        histogram[3] += both;
+        histogram[2] += bit1 - both;
+        histogram[1] += bit0 - both;
+        histogram[0] += n - bit0 - bit1 + both;
     }
 
     std::vector<std::uint64_t> histogram = std::vector<std::uint64_t>(outcome_count, 0);
