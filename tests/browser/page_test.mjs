@@ -71,6 +71,26 @@ try {
     return { zoom: m.getZoom(), center: m.getCenter() };
   });
 
+  // The page's own texts, for a failure message.
+  const texts = () => page.evaluate(() => Object.fromEntries(["readout", "trajectory-info", "message"].map(
+    (id) => [id, document.getElementById(id) ? document.getElementById(id).textContent : null])));
+  // The pointer at (x, y) and the count of the launch under it in the readout. A loaded
+  // machine (the other tests run beside this one) can swallow a move made while the map
+  // still animates: the pointer moves again, off by a pixel and back, up to three times.
+  const readoutAt = async (x, y) => {
+    for (let attempt = 0; ; ++attempt) {
+      await page.mouse.move(x + 1, y);
+      await page.mouse.move(x, y);
+      try {
+        await page.waitForFunction(() => /N  = \d+ wall bounce/.test(document.getElementById("readout").textContent),
+                                   { timeout: 10000 });
+        return;
+      } catch (err) {
+        if (attempt == 2) throw new Error("no count in the readout after 3 moves: " + JSON.stringify(await texts()));
+      }
+    }
+  };
+
   await page.goto(url + "#" + view.toString(), { waitUntil: "networkidle0" });
   await page.waitForFunction(() => window.explorer && window.explorer.map);
   const first = await mapState();
@@ -120,8 +140,7 @@ try {
   const probe = { xi: zoomView.sw.x + 0.3 * (zoomView.ne.x - zoomView.sw.x),
                   W: zoomView.sw.y + 0.4 * (zoomView.ne.y - zoomView.sw.y) };
   const p = await pointOf(probe.xi, probe.W);
-  await page.mouse.move(mapBox.x + p.x, mapBox.y + p.y);
-  await page.waitForFunction(() => /N  = \d+ wall bounce/.test(document.getElementById("readout").textContent));
+  await readoutAt(mapBox.x + p.x, mapBox.y + p.y);
   report.readout = {
     text: await page.$eval("#readout", (e) => e.textContent),
     start: await page.evaluate(() => window.explorer.readoutStart),
@@ -152,8 +171,7 @@ try {
 
   // The screenshot: the map, and the panel from its top (readout, trajectory, view).
   await page.$eval("#panel", (e) => { e.scrollTop = 0; });
-  await page.mouse.move(mapBox.x + p.x, mapBox.y + p.y);
-  await page.waitForFunction(() => /N  = \d+ wall bounce/.test(document.getElementById("readout").textContent));
+  await readoutAt(mapBox.x + p.x, mapBox.y + p.y);
   await page.screenshot({ path: screenshot });
 } finally {
   await browser.close();
