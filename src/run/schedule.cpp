@@ -15,13 +15,16 @@ namespace {
 constexpr int tag_up = 21;
 constexpr int tag_down = 22;
 
-// Up message: {flags, weight, groups, then per group: rank, n, n (tile, checksum) pairs}.
-// The weight is the number of computing ranks the sender speaks for (1, or a node).
-constexpr std::uint64_t want_block = 1;  // asks for the next block
+// Up message: {flags, weight, unstarted, groups, per group: rank, n, n (tile, checksum)
+// pairs; ranges, then (first, count) per range}. The weight is the number of computing
+// ranks the sender speaks for (1, or a node); unstarted, the tiles it and the ranks it
+// serves hold and have not started; the ranges, tiles it gives back.
+constexpr std::uint64_t want_block = 1;     // asks for the next block
 constexpr std::uint64_t final_message = 2;  // the sender is done: no message follows
-constexpr std::uint64_t stopping = 4;  // the sender saw a stop: stop everyone
+constexpr std::uint64_t stopping = 4;       // the sender saw a stop: stop everyone
+constexpr std::uint64_t gift = 8;           // answers give_back (with no range: none to give)
 // Down message: {kind, first, count, tiles the sender has left to hand out}.
-enum class Down : std::uint64_t { assign = 1, end = 2, stop = 3, bye = 4 };
+enum class Down : std::uint64_t { assign = 1, end = 2, stop = 3, bye = 4, give_back = 5 };
 constexpr int down_words = 4;
 
 struct Range {
@@ -78,6 +81,13 @@ double now() { return MPI_Wtime(); }
 // One rank's part of the schedule: a server (rank 0, node leaders) hands out blocks from
 // its pool to the ranks it serves and passes their reports up; a rank with a server asks
 // it for blocks; every rank but a dedicated rank 0 computes tiles from its pool.
+//
+// When a server's pool is empty for good (rank 0's, or a leader's once rank 0 has
+// nothing more), the ranks that ask are not sent away while others still hold unstarted
+// tiles: the server asks the rank holding the most (it learns that from every message)
+// to give back the second half of them, and hands those out. Costs cluster in the tile
+// order (a block of the first, largest blocks can hold many times a rank's share of the
+// work), so without this the run would last as long as its costliest block.
 class Scheduler {
 public:
     Scheduler(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work, const TilesDone& done,
@@ -113,8 +123,13 @@ public:
             by_leader_rank_.assign(static_cast<std::size_t>(leaders.size()), -1);
             for (int r = 1; r < leaders.size(); ++r) add_child(leaders.get(), r, by_leader_rank_);
         }
-        if (!children_.empty()) serve_ = [this] { poll(); };
-        else serve_ = [] {};
+        // Within a tile too: a server answers the ranks it serves, a served rank its
+        // server's requests for tiles back.
+        if (!children_.empty() || !root_) {
+            serve_ = [this] { poll(); };
+        } else {
+            serve_ = [] {};
+        }
     }
 
     void run()
@@ -125,9 +140,12 @@ public:
         for (;;) {
             if (!stopped_ && stop_()) begin_stop();
             if (computes_ && !stopped_ && next_tile()) {
-                work_.compute(pending_[current_.first], serve_);
-                ++current_.first;
+                idle_ = false;
+                // Taken out of the block first: current_ holds unstarted tiles only, any of
+                // which may be given back while this one is computed.
+                const std::uint64_t i = current_.first++;
                 --current_.count;
+                work_.compute(pending_[i], serve_);
                 ++stats.tiles;
                 ++unflushed_;
                 after_tile();
@@ -148,9 +166,11 @@ private:
         MPI_Comm comm = MPI_COMM_NULL;
         int rank = 0;
         std::uint64_t weight = 1;
-        bool active = true;      // no final message yet
+        std::uint64_t unstarted = 0;  // tiles it holds and has not started, as last heard
+        bool active = true;           // no final message yet
         bool stop_sent = false;
-        bool waiting = false;    // asked for a block this server does not have yet
+        bool waiting = false;         // asked for a block this server does not have yet
+        bool asked_back = false;      // was asked to give tiles back, no answer yet
     };
 
     void add_child(MPI_Comm comm, int rank, std::vector<int>& index)
@@ -203,6 +223,60 @@ private:
         return r;
     }
 
+    void add_to_pool(Range r)
+    {
+        if (r.count == 0) return;
+        pool_.push_back(r);
+        pool_tiles_ += r.count;
+    }
+
+    // Unstarted tiles this rank holds, with those of the ranks it serves as last heard.
+    std::uint64_t unstarted() const
+    {
+        std::uint64_t n = current_.count + pool_tiles_;
+        for (const Child& c : children_) {
+            if (c.active) n += c.unstarted;
+        }
+        return n;
+    }
+
+    // The second half of this rank's own unstarted tiles (the end of its queue, then the
+    // end of its current block), taken away: at most two ranges.
+    std::vector<Range> take_back_half()
+    {
+        const std::uint64_t n = half((current_.count + pool_tiles_));
+        stats.given_back += n;
+        return take_back(n);
+    }
+
+    // Half of n, in whole granules where that leaves some: blocks end on granules, so the
+    // tiles given back start on one.
+    std::uint64_t half(std::uint64_t n) const
+    {
+        std::uint64_t h = n / 2;
+        if (settings_.granule > 1 && h >= settings_.granule) h -= h % settings_.granule;
+        return h;
+    }
+
+    std::vector<Range> take_back(std::uint64_t n)
+    {
+        std::vector<Range> out;
+        while (n > 0 && !pool_.empty()) {
+            Range& back = pool_.back();
+            const std::uint64_t k = std::min(n, back.count);
+            out.push_back({back.first + back.count - k, k});
+            back.count -= k;
+            pool_tiles_ -= k;
+            n -= k;
+            if (back.count == 0) pool_.pop_back();
+        }
+        if (n > 0) {
+            out.push_back({current_.first + current_.count - n, n});
+            current_.count -= n;
+        }
+        return out;
+    }
+
     // Writes this rank's finished tiles and queues their reports (rank 0 records them).
     void report_own()
     {
@@ -237,10 +311,12 @@ private:
         done_(reports, rank);
     }
 
-    void send_up(std::uint64_t flags)
+    void send_up(std::uint64_t flags, const std::vector<Range>& given = {})
     {
-        std::vector<std::uint64_t> msg{flags, children_.empty() ? 1 : node_computing_ranks_, outbox_groups_};
+        std::vector<std::uint64_t> msg{flags, children_.empty() ? 1 : node_computing_ranks_, unstarted(), outbox_groups_};
         msg.insert(msg.end(), outbox_.begin(), outbox_.end());
+        msg.push_back(given.size());
+        for (const Range& r : given) msg.insert(msg.end(), {r.first, r.count});
         outbox_.clear();
         outbox_groups_ = 0;
         next_forward_ = now() + settings_.report_seconds / 2;
@@ -309,8 +385,9 @@ private:
         ++stats.messages_in;
         const std::uint64_t flags = msg[0];
         c.weight = msg[1];
-        const std::uint64_t groups = msg[2];
-        std::size_t at = 3;
+        c.unstarted = msg[2];
+        const std::uint64_t groups = msg[3];
+        std::size_t at = 4;
         for (std::uint64_t g = 0; g < groups; ++g) {
             const std::uint64_t rank = msg[at];
             const std::uint64_t n = msg[at + 1];
@@ -325,14 +402,23 @@ private:
             }
             at += 2 + 2 * n;
         }
+        std::vector<Range> given(msg[at]);
+        for (std::size_t i = 0; i < given.size(); ++i) given[i] = {msg[at + 1 + 2 * i], msg[at + 2 + 2 * i]};
+
         if (flags & final_message) c.active = false;  // nothing more to tell it but goodbye
         // A rank told to stop (SIGTERM reaches every rank under Slurm) stops them all.
         if (flags & stopping) begin_stop();
+        // The answer to a request for tiles back; a rank that ended instead gave none.
+        if ((flags & gift) || ((flags & final_message) && c.asked_back)) {
+            c.asked_back = false;
+            received_back(given);
+        }
         if (flags & want_block) {
             ++stats.requests_in;
             answer(c);
         }
         if (flags & final_message) send_down(c, Down::bye);
+        rebalance();
     }
 
     void answer(Child& c)
@@ -342,13 +428,28 @@ private:
         if (pool_tiles_ > 0) {
             const Range r = take(block_for(c.weight));
             stats.handed_out.push_back(r.count);
+            c.unstarted += r.count;
             send_down(c, Down::assign, r);
-        } else if (root_ || parent_end_) {
-            send_down(c, Down::end);
         } else {
-            c.waiting = true;  // answered when this leader's own request is
+            c.waiting = true;  // answered when tiles come: from this server's server, or given back
             maybe_request();
         }
+    }
+
+    // Tiles given back by a rank this one serves: passed up if this rank's server asked
+    // for them, handed out here otherwise.
+    void received_back(const std::vector<Range>& given)
+    {
+        std::uint64_t n = 0;
+        for (const Range& r : given) n += r.count;
+        if (owe_back_) {
+            if (n == 0 && ask_back()) return;  // try the next fullest rank
+            owe_back_ = false;
+            send_up(gift, given);
+            return;
+        }
+        for (const Range& r : given) add_to_pool(r);
+        serve_waiting();
     }
 
     void receive_down()
@@ -359,10 +460,7 @@ private:
         case Down::assign:
             outstanding_ = false;
             parent_remaining_ = msg[3];
-            if (msg[2] > 0) {
-                pool_.push_back({msg[1], msg[2]});
-                pool_tiles_ += msg[2];
-            }
+            add_to_pool({msg[1], msg[2]});
             serve_waiting();
             break;
         case Down::end:
@@ -374,15 +472,88 @@ private:
             stop_from_parent_ = true;
             begin_stop();
             break;
+        case Down::give_back:
+            give_back();
+            break;
         case Down::bye:
             throw std::logic_error("schedule: goodbye from the server before this rank's final message");
         }
     }
 
+    // The server wants tiles back: half of this rank's own, or, if a rank it serves holds
+    // more, half of that one's (passed on when it answers).
+    void give_back()
+    {
+        if (stopped_) {
+            send_up(gift);
+            return;
+        }
+        const Child* fullest = fullest_child();
+        if (fullest && fullest->unstarted > current_.count + pool_tiles_ && ask_back()) {
+            owe_back_ = true;
+            return;
+        }
+        send_up(gift, take_back_half());
+        maybe_request();  // the queued block may have gone back
+    }
+
+    const Child* fullest_child() const
+    {
+        const Child* best = nullptr;
+        for (const Child& c : children_) {
+            if (c.active && !c.asked_back && c.unstarted >= 2 && (!best || c.unstarted > best->unstarted)) best = &c;
+        }
+        return best;
+    }
+
+    // Asks the rank with the most unstarted tiles for half of them; false if none has two.
+    bool ask_back()
+    {
+        const Child* best = fullest_child();
+        if (!best) return false;
+        Child& c = children_[static_cast<std::size_t>(best - children_.data())];
+        c.asked_back = true;
+        send_down(c, Down::give_back);
+        return true;
+    }
+
     void serve_waiting()
     {
         for (Child& c : children_) {
-            if (c.waiting && c.active && (pool_tiles_ > 0 || parent_end_)) answer(c);
+            if (c.waiting && c.active && pool_tiles_ > 0) answer(c);
+        }
+        rebalance();
+    }
+
+    // With the pool empty for good and ranks waiting (this one included), asks for tiles
+    // back, from as many ranks as are waiting; when nobody holds two unstarted tiles any
+    // more, the waiting ranks are done.
+    void rebalance()
+    {
+        if (stopped_ || pool_tiles_ > 0 || children_.empty() || !(root_ || parent_end_)) return;
+        std::uint64_t waiting = idle_ ? 1 : 0;
+        std::uint64_t asked = 0;
+        for (const Child& c : children_) {
+            if (c.active && c.waiting) ++waiting;
+            if (c.active && c.asked_back) ++asked;
+        }
+        if (waiting == 0) return;
+        // This rank's own block first if it is the fullest: no message needed.
+        const Child* fullest = fullest_child();
+        if (current_.count >= 2 && (!fullest || current_.count >= fullest->unstarted)) {
+            const std::uint64_t n = half(current_.count);
+            stats.given_back += n;
+            for (const Range& r : take_back(n)) add_to_pool(r);
+            serve_waiting();
+            return;
+        }
+        while (asked < waiting && ask_back()) ++asked;
+        if (asked > 0 || owe_back_) return;
+        for (Child& c : children_) {
+            if (c.active && c.waiting) {
+                c.waiting = false;
+                send_down(c, Down::end);
+            }
         }
     }
 
@@ -398,13 +569,17 @@ private:
                 send_down(c, Down::stop);
             }
         }
+        if (owe_back_) {
+            owe_back_ = false;
+            send_up(gift);
+        }
         if (!root_ && !children_.empty() && !stop_from_parent_) send_up(stopping);
     }
 
     bool finished() const
     {
         const bool own_done = !computes_ || stopped_ || (current_.count == 0 && pool_tiles_ == 0 && (root_ || parent_end_));
-        return own_done && std::none_of(children_.begin(), children_.end(), [](const Child& c) { return c.active; });
+        return own_done && !owe_back_ && std::none_of(children_.begin(), children_.end(), [](const Child& c) { return c.active; });
     }
 
     // Nothing to compute: wait for a message (a plain rank blocks on its server's answer;
@@ -412,6 +587,7 @@ private:
     // stop signal and never holds a core for nothing).
     void wait()
     {
+        idle_ = computes_ && !stopped_;
         if (unflushed_ > 0) report_own();  // idle anyway: a good time to write
         send_reports_if_due();
         if (children_.empty()) {
@@ -419,13 +595,14 @@ private:
             receive_down();
             return;
         }
+        rebalance();
         if (poll()) {
             idle_pause_ = min_pause;
             return;
         }
         if (!stopped_ && stop_()) begin_stop();
         pause(idle_pause_);
-        idle_pause_ = std::min(2 * idle_pause_, max_pause);
+        idle_pause_ = std::min(2 * idle_pause_, std::max(min_pause, settings_.idle_poll_seconds));
     }
 
     void finish()
@@ -436,12 +613,13 @@ private:
         for (;;) {
             std::uint64_t msg[down_words] = {};
             mpi::check(MPI_Recv(msg, down_words, MPI_UINT64_T, 0, tag_down, parent_comm_, MPI_STATUS_IGNORE), "MPI_Recv");
-            if (static_cast<Down>(msg[0]) == Down::bye) return;  // answers, stops: all moot now
+            if (static_cast<Down>(msg[0]) == Down::bye) return;  // answers, stops, asks: all moot now
         }
     }
 
+    // An idle server polls every 20 us at first, then less and less often down to
+    // settings_.idle_poll_seconds.
     static constexpr double min_pause = 20e-6;
-    static constexpr double max_pause = 1e-3;
 
     std::span<const std::uint64_t> pending_;
     TileWork& work_;
@@ -463,17 +641,19 @@ private:
     MPI_Comm parent_comm_ = MPI_COMM_NULL;  // the server is rank 0 of it
     bool outstanding_ = false;  // a request is on its way to the server
     bool parent_end_ = false;   // the server has no more blocks
+    bool owe_back_ = false;     // the server asked for tiles back; a rank served here was asked in turn
     std::uint64_t parent_remaining_ = 0;
 
     std::deque<Range> pool_;
     std::uint64_t pool_tiles_ = 0;
-    Range current_;
+    Range current_;  // unstarted tiles of the block being computed
     std::uint64_t unflushed_ = 0;  // tiles computed since the last flush
     std::vector<std::uint64_t> outbox_;  // report groups to send up
     std::uint64_t outbox_groups_ = 0;
     double next_report_ = 0;
     double next_forward_ = 0;
     double idle_pause_ = min_pause;
+    bool idle_ = false;  // a computing rank with nothing to compute, waiting
 
     bool stopped_ = false;
     bool stop_from_parent_ = false;

@@ -79,6 +79,11 @@ struct ScheduleSettings {
     // n consecutive ranks, which forces the two-level scheme on one machine (tests), or
     // names the nodes where MPI_Comm_split_type cannot (SMPI).
     int node_ranks = 0;
+    // A server with nothing to do (a dedicated rank 0, a leader whose ranks are busy)
+    // sleeps between looks for messages, longer and longer up to this: the delay of its
+    // first answer after a quiet spell, and of its noticing a stop signal. (Idle, it
+    // costs nothing either way; a simulation of hours of cluster time wants fewer looks.)
+    double idle_poll_seconds = 1e-3;
 };
 
 // What one rank saw of the schedule (for tests, benchmarks and the simulation).
@@ -92,6 +97,7 @@ struct ScheduleStats {
     // Sizes of the blocks a server (rank 0, node leaders) took from its pool, for the
     // ranks it serves and for itself, in order.
     std::vector<std::uint64_t> handed_out;
+    std::uint64_t given_back = 0;    // tiles it gave back (to its server, or to its own pool)
     bool two_level = false;          // node leaders were used (same on every rank)
     bool leader = false;             // this rank served a node (rank 0 included)
     bool computed = false;           // this rank computed tiles (false: a scheduler only)

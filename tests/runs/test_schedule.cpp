@@ -123,7 +123,7 @@ struct Outcome {
     std::vector<Reported> reported;
     std::vector<std::vector<std::uint64_t>> computed, written, handed_out;
     std::vector<std::vector<double>> started, ended, written_at, returned;
-    std::vector<std::vector<std::uint64_t>> stats;  // per rank: tiles, blocks, flushes, computed (0/1), two_level
+    std::vector<std::vector<std::uint64_t>> stats;  // per rank: tiles, blocks, flushes, computed (0/1), two_level, given_back
 };
 
 Outcome run_once(const std::vector<std::uint64_t>& pending, const ScheduleSettings& settings, double tile_seconds,
@@ -146,7 +146,8 @@ Outcome run_once(const std::vector<std::uint64_t>& pending, const ScheduleSettin
     out.ended = gather(work.ended);
     out.written_at = gather(work.written_at);
     out.returned = gather(std::vector<double>{out.returned_at});
-    out.stats = gather(std::vector<std::uint64_t>{s.tiles, s.blocks, s.flushes, s.computed ? 1u : 0u, s.two_level ? 1u : 0u});
+    out.stats = gather(std::vector<std::uint64_t>{s.tiles, s.blocks, s.flushes, s.computed ? 1u : 0u, s.two_level ? 1u : 0u,
+                                                  s.given_back});
     return out;
 }
 
@@ -301,9 +302,10 @@ void stop_on_one_rank(const Mode& mode, int stopper)
     const double stop_time = stop_times[static_cast<std::size_t>(stopper)].at(0);
     ASSERT_GT(stop_time, 0);
     for (std::size_t rank = 0; rank < r.started.size(); ++rank) {
-        // The tile in progress, and one started before the stop message arrived.
-        const auto late = std::count_if(r.started[rank].begin(), r.started[rank].end(), [&](double t) { return t > stop_time; });
-        EXPECT_LE(late, 2) << "rank " << rank << " started " << late << " tiles after the stop on rank " << stopper;
+        // An idle server looks for messages every millisecond (idle_poll_seconds): a
+        // tile or two may start before the stop reaches a rank, none long after.
+        const double last = r.started[rank].empty() ? 0 : *std::max_element(r.started[rank].begin(), r.started[rank].end());
+        EXPECT_LT(last - stop_time, 0.05) << "rank " << rank << " started a tile long after the stop on rank " << stopper;
         EXPECT_LT(r.returned[rank][0] - stop_time, 0.25) << "rank " << rank << " returned late";
     }
 }
@@ -316,16 +318,16 @@ TEST_P(Schedule, StopOnTheLastRankEndsEveryRank)
     stop_on_one_rank(GetParam(), world.size() - 1);
 }
 
-// Blocks of 150 tiles of 1 ms, reports every 20 ms: the journal hears of each tile soon
-// after it is computed, not when its block ends. (Two modes, the test takes time: the
-// plain one, and the one with the most hops.)
-class ScheduleReports : public Schedule {};
+// The tests that take time run in two modes: the plain one, and the one with the most hops.
+class ScheduleTimed : public Schedule {};
 
-INSTANTIATE_TEST_SUITE_P(Modes, ScheduleReports,
+INSTANTIATE_TEST_SUITE_P(Modes, ScheduleTimed,
                          testing::Values(Mode{"one_level", 64, 0}, Mode{"two_level_dedicated_root", 2, 2}),
                          [](const testing::TestParamInfo<Mode>& i) { return std::string(i.param.name); });
 
-TEST_P(ScheduleReports, ArriveWithinThePeriodMidBlock)
+// Blocks of 150 tiles of 1 ms, reports every 20 ms: the journal hears of each tile soon
+// after it is computed, not when its block ends.
+TEST_P(ScheduleTimed, ReportsArriveWithinThePeriodMidBlock)
 {
     const double tile = 0.001;
     ScheduleSettings s = settings_of(GetParam());
@@ -340,8 +342,8 @@ TEST_P(ScheduleReports, ArriveWithinThePeriodMidBlock)
     for (std::size_t rank = 0; rank < r.computed.size(); ++rank) {
         for (std::size_t i = 0; i < r.computed[rank].size(); ++i) ended[r.computed[rank][i]] = r.ended[rank][i];
     }
-    // A period, half one more through a node leader, and scheduling noise on 2 cores.
-    const double bound = 1.5 * s.report_seconds + 0.05;
+    // A period, half one more through a node leader, and scheduling noise on 2 busy cores.
+    const double bound = 1.5 * s.report_seconds + 0.08;
     double worst = 0;
     for (const Reported& x : r.reported) worst = std::max(worst, x.at - ended.at(x.report.tile));
     EXPECT_LT(worst, bound) << "a tile waited " << worst << " s to be reported; the first blocks last "
@@ -356,7 +358,8 @@ TEST_P(ScheduleReports, ArriveWithinThePeriodMidBlock)
 }
 
 // Guided self-scheduling, one level: blocks of remaining / (2 ranks), never growing, down
-// to single tiles; O(P log(N/P)) of them, not N.
+// to single tiles; O(P log(N/P)) of them, not N. (Tiles given back at the end are handed
+// out again after that.)
 TEST(ScheduleOneLevel, BlocksShrinkAndAreFew)
 {
     const std::uint64_t n = 20000;
@@ -368,14 +371,69 @@ TEST(ScheduleOneLevel, BlocksShrinkAndAreFew)
     const auto p = static_cast<std::uint64_t>(world.size());
     ASSERT_FALSE(blocks.empty());
     EXPECT_EQ(blocks.front(), n / (2 * p));
-    EXPECT_EQ(blocks.back(), 1u);
-    EXPECT_TRUE(std::is_sorted(blocks.rbegin(), blocks.rend())) << "a block grew";
-    std::uint64_t sum = 0;
+    const auto first_single = std::find(blocks.begin(), blocks.end(), 1u);
+    EXPECT_NE(first_single, blocks.end()) << "the last blocks are single tiles";
+    EXPECT_TRUE(std::is_sorted(std::make_reverse_iterator(first_single), blocks.rend())) << "a block grew";
+    std::uint64_t sum = 0, given_back = 0;
     for (const std::uint64_t b : blocks) sum += b;
-    EXPECT_EQ(sum, n);
+    for (const auto& st : r.stats) given_back += st[5];
+    EXPECT_EQ(sum, n + given_back) << "every tile handed out once, and once more each time it was given back";
     const double bound = 2.0 * static_cast<double>(p) * (std::log(static_cast<double>(n) / static_cast<double>(p)) + 2);
-    EXPECT_LE(static_cast<double>(blocks.size()), bound);
+    EXPECT_LE(static_cast<double>(blocks.size()), bound + static_cast<double>(given_back));
     EXPECT_LE(r.result.stats.requests_in, blocks.size() + p) << "one request per block, one more per rank";
+}
+
+// The first quarter of the tiles costs 8 ms, the rest nothing, so the first block (half a
+// rank's share of tiles) holds twice a rank's share of the work: the ranks that run out of
+// blocks take the second half of what others hold, and all finish together.
+TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
+{
+    const int ranks = world.size();
+    const int computing = ranks - (GetParam().dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
+    const std::uint64_t n = 100 * static_cast<std::uint64_t>(computing);
+    const std::vector<std::uint64_t> pending = iota(n);
+    const double heavy = 0.008;
+    // Sleeps overshoot on a busy machine: what the heavy tiles really took is measured.
+    class Clustered final : public TileWork {
+    public:
+        Clustered(std::uint64_t n, double heavy) : n_(n), heavy_(heavy) {}
+        void compute(std::uint64_t tile, const Serve& serve) override
+        {
+            const double start = seconds();
+            for (int i = 0; i < 4; ++i) {
+                if (4 * tile < n_) std::this_thread::sleep_for(std::chrono::duration<double>(heavy_ / 4));
+                serve();
+            }
+            if (4 * tile < n_) heavy_seconds += seconds() - start;
+            done_.push_back({tile, checksum_of(tile)});
+        }
+        std::vector<TileReport> flush() override { return std::exchange(done_, {}); }
+        double heavy_seconds = 0;
+
+    private:
+        std::uint64_t n_;
+        double heavy_;
+        std::vector<TileReport> done_;
+    } work(n, heavy);
+    std::uint64_t reported = 0;
+    const TilesDone done = [&](std::span<const TileReport> tiles, int) { reported += tiles.size(); };
+    world.barrier();
+    const double start = seconds();
+    const ScheduleResult r = run_schedule(world, pending, work, done, [] { return false; }, settings_of(GetParam()));
+    const double took = seconds() - start;
+    EXPECT_FALSE(r.interrupted);
+    if (world.is_root()) {
+        EXPECT_EQ(reported, n);
+    }
+    double all_heavy = 0;
+    mpi::check(MPI_Allreduce(&work.heavy_seconds, &all_heavy, 1, MPI_DOUBLE, MPI_SUM, world.get()), "MPI_Allreduce");
+    if (computing < 2) return;  // nobody to take tiles
+    const double ideal = all_heavy / computing;
+    const double first_block = all_heavy / static_cast<double>(n / 4) * static_cast<double>(n / (2 * static_cast<std::uint64_t>(computing)));
+    // Before the first block alone would end (ideal: half that).
+    EXPECT_LT(took, 0.9 * first_block) << "ideal " << ideal << " s; the first block alone takes " << first_block
+                                      << " s; this rank computed " << r.stats.tiles << " tiles in " << r.stats.blocks
+                                      << " blocks, gave back " << r.stats.given_back;
 }
 
 }  // namespace
