@@ -15,10 +15,12 @@ namespace {
 constexpr int tag_up = 21;
 constexpr int tag_down = 22;
 
-// Up message: {flags, weight, unstarted, groups, per group: rank, n, n (tile, checksum)
-// pairs; ranges, then (first, count) per range}. The weight is the number of computing
-// ranks the sender speaks for (1, or a node); unstarted, the tiles it and the ranks it
-// serves hold and have not started; the ranges, tiles it gives back.
+// Up message: {flags, weight, unstarted, received, idle, groups, per group: rank, n, n
+// (tile, checksum) pairs; ranges, then (first, count) per range}. The weight is the number
+// of computing ranks the sender speaks for (1, or a node); unstarted, the tiles it and the
+// ranks it serves hold and have not started; received, the tiles its server has assigned
+// it so far (so the server can add those still on their way); idle, how many of those
+// ranks have nothing to compute; the ranges, tiles it gives back.
 constexpr std::uint64_t want_block = 1;     // asks for the next block
 constexpr std::uint64_t final_message = 2;  // the sender is done: no message follows
 constexpr std::uint64_t stopping = 4;       // the sender saw a stop: stop everyone
@@ -136,11 +138,11 @@ public:
     {
         next_report_ = now() + settings_.report_seconds;
         next_forward_ = now() + settings_.report_seconds / 2;
+        idle_ = computes_;  // nothing to compute yet
         maybe_request();
         for (;;) {
             if (!stopped_ && stop_()) begin_stop();
             if (computes_ && !stopped_ && next_tile()) {
-                idle_ = false;
                 // Taken out of the block first: current_ holds unstarted tiles only, any of
                 // which may be given back while this one is computed.
                 const std::uint64_t i = current_.first++;
@@ -167,6 +169,8 @@ private:
         int rank = 0;
         std::uint64_t weight = 1;
         std::uint64_t unstarted = 0;  // tiles it holds and has not started, as last heard
+        std::uint64_t assigned = 0;   // tiles assigned to it so far
+        std::uint64_t idle = 0;       // ranks under it with nothing to compute, as last heard
         bool active = true;           // no final message yet
         bool stop_sent = false;
         bool waiting = false;         // asked for a block this server does not have yet
@@ -190,6 +194,7 @@ private:
         current_ = take(server ? block_for(1) : pool_.front().count);
         if (server) stats.handed_out.push_back(current_.count);
         ++stats.blocks;
+        idle_ = false;
         maybe_request();  // keeps the next block coming while this one is computed
         return true;
     }
@@ -228,6 +233,16 @@ private:
         if (r.count == 0) return;
         pool_.push_back(r);
         pool_tiles_ += r.count;
+    }
+
+    // Ranks with nothing to compute here: this one, and those waiting under it.
+    std::uint64_t idle_ranks() const
+    {
+        std::uint64_t n = idle_ ? 1 : 0;
+        for (const Child& c : children_) {
+            if (c.active && c.waiting) n += c.idle;
+        }
+        return n;
     }
 
     // Unstarted tiles this rank holds, with those of the ranks it serves as last heard.
@@ -313,7 +328,9 @@ private:
 
     void send_up(std::uint64_t flags, const std::vector<Range>& given = {})
     {
-        std::vector<std::uint64_t> msg{flags, children_.empty() ? 1 : node_computing_ranks_, unstarted(), outbox_groups_};
+        sent_idle_ = idle_ranks();
+        std::vector<std::uint64_t> msg{flags, children_.empty() ? 1 : node_computing_ranks_, unstarted(), received_,
+                                       sent_idle_, outbox_groups_};
         msg.insert(msg.end(), outbox_.begin(), outbox_.end());
         msg.push_back(given.size());
         for (const Range& r : given) msg.insert(msg.end(), {r.first, r.count});
@@ -385,9 +402,10 @@ private:
         ++stats.messages_in;
         const std::uint64_t flags = msg[0];
         c.weight = msg[1];
-        c.unstarted = msg[2];
-        const std::uint64_t groups = msg[3];
-        std::size_t at = 4;
+        c.unstarted = msg[2] + (c.assigned - msg[3]);
+        c.idle = msg[4];
+        const std::uint64_t groups = msg[5];
+        std::size_t at = 6;
         for (std::uint64_t g = 0; g < groups; ++g) {
             const std::uint64_t rank = msg[at];
             const std::uint64_t n = msg[at + 1];
@@ -429,6 +447,7 @@ private:
             const Range r = take(block_for(c.weight));
             stats.handed_out.push_back(r.count);
             c.unstarted += r.count;
+            c.assigned += r.count;
             send_down(c, Down::assign, r);
         } else {
             c.waiting = true;  // answered when tiles come: from this server's server, or given back
@@ -460,6 +479,7 @@ private:
         case Down::assign:
             outstanding_ = false;
             parent_remaining_ = msg[3];
+            received_ += msg[2];
             add_to_pool({msg[1], msg[2]});
             serve_waiting();
             break;
@@ -517,10 +537,13 @@ private:
         return true;
     }
 
+    // The ranks out of work first, then those that asked ahead.
     void serve_waiting()
     {
-        for (Child& c : children_) {
-            if (c.waiting && c.active && pool_tiles_ > 0) answer(c);
+        for (const bool idle : {true, false}) {
+            for (Child& c : children_) {
+                if (c.waiting && c.active && (c.idle > 0) == idle && pool_tiles_ > 0) answer(c);
+            }
         }
         rebalance();
     }
@@ -530,17 +553,25 @@ private:
     // more, the waiting ranks are done.
     void rebalance()
     {
-        if (stopped_ || pool_tiles_ > 0 || children_.empty() || !(root_ || parent_end_)) return;
-        std::uint64_t waiting = idle_ ? 1 : 0;
+        if (stopped_ || pool_tiles_ > 0 || children_.empty()) return;
+        if (!(root_ || parent_end_)) {
+            // Rank 0 decides: it hears how many ranks here have nothing to do.
+            if (outstanding_ && idle_ranks() > sent_idle_) send_up(0);
+            return;
+        }
+        bool anyone = false;
+        for (const Child& c : children_) anyone = anyone || (c.active && c.waiting);
+        if (!anyone && !idle_) return;
+        // Tiles back for the ranks out of work, not for those still computing the block
+        // they asked ahead of.
+        const std::uint64_t waiting = idle_ranks();
         std::uint64_t asked = 0;
         for (const Child& c : children_) {
-            if (c.active && c.waiting) ++waiting;
             if (c.active && c.asked_back) ++asked;
         }
-        if (waiting == 0) return;
         // This rank's own block first if it is the fullest: no message needed.
         const Child* fullest = fullest_child();
-        if (current_.count >= 2 && (!fullest || current_.count >= fullest->unstarted)) {
+        if (waiting > 0 && current_.count >= 2 && (!fullest || current_.count >= fullest->unstarted)) {
             const std::uint64_t n = half(current_.count);
             stats.given_back += n;
             for (const Range& r : take_back(n)) add_to_pool(r);
@@ -548,7 +579,8 @@ private:
             return;
         }
         while (asked < waiting && ask_back()) ++asked;
-        if (asked > 0 || owe_back_) return;
+        // Someone can still give tiles back: the waiting ranks wait for them.
+        if (asked > 0 || owe_back_ || fullest_child() || current_.count >= 2) return;
         for (Child& c : children_) {
             if (c.active && c.waiting) {
                 c.waiting = false;
@@ -588,10 +620,19 @@ private:
     void wait()
     {
         idle_ = computes_ && !stopped_;
+        const double since = now();
+        struct Clock {
+            double since;
+            double& total;
+            ~Clock() { total += now() - since; }
+        } clock{since, stats.idle_seconds};
         if (unflushed_ > 0) report_own();  // idle anyway: a good time to write
         send_reports_if_due();
         if (children_.empty()) {
             if (!outstanding_) throw std::logic_error("schedule: waiting with no request in flight");
+            // The request went out ahead, when this rank still had a block: now it has
+            // nothing, which its server needs to know to take tiles back for it.
+            if (idle_ && sent_idle_ == 0) send_up(0);
             receive_down();
             return;
         }
@@ -643,6 +684,8 @@ private:
     bool parent_end_ = false;   // the server has no more blocks
     bool owe_back_ = false;     // the server asked for tiles back; a rank served here was asked in turn
     std::uint64_t parent_remaining_ = 0;
+    std::uint64_t received_ = 0;  // tiles the server assigned this rank so far
+    std::uint64_t sent_idle_ = 0;  // idle ranks counted in the last message up
 
     std::deque<Range> pool_;
     std::uint64_t pool_tiles_ = 0;

@@ -383,57 +383,52 @@ TEST(ScheduleOneLevel, BlocksShrinkAndAreFew)
     EXPECT_LE(r.result.stats.requests_in, blocks.size() + p) << "one request per block, one more per rank";
 }
 
-// The first quarter of the tiles costs 8 ms, the rest nothing, so the first block (half a
-// rank's share of tiles) holds twice a rank's share of the work: the ranks that run out of
-// blocks take the second half of what others hold, and all finish together.
+// The first eighth of the tiles costs 8 ms, the rest nothing, so the first block (half a
+// rank's share of tiles) holds all of the work: the ranks that run out of blocks take the
+// second half of what others hold, and the costly tiles end up shared. (Counted, not
+// timed: this machine's load makes times vary.)
 TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
 {
     const int ranks = world.size();
     const int computing = ranks - (GetParam().dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
     const std::uint64_t n = 100 * static_cast<std::uint64_t>(computing);
     const std::vector<std::uint64_t> pending = iota(n);
-    const double heavy = 0.008;
-    // Sleeps overshoot on a busy machine: what the heavy tiles really took is measured.
     class Clustered final : public TileWork {
     public:
-        Clustered(std::uint64_t n, double heavy) : n_(n), heavy_(heavy) {}
+        explicit Clustered(std::uint64_t n) : n_(n) {}
         void compute(std::uint64_t tile, const Serve& serve) override
         {
-            const double start = seconds();
-            for (int i = 0; i < 4; ++i) {
-                if (4 * tile < n_) std::this_thread::sleep_for(std::chrono::duration<double>(heavy_ / 4));
+            // Light tiles do not even call serve: with more ranks than cores, Open MPI
+            // yields the core in every probe, which would make them costly too.
+            const bool heavy = 8 * tile < n_;
+            for (int i = 0; heavy && i < 4; ++i) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(2));
                 serve();
             }
-            if (4 * tile < n_) heavy_seconds += seconds() - start;
+            if (heavy) ++heavy_tiles;
             done_.push_back({tile, checksum_of(tile)});
         }
         std::vector<TileReport> flush() override { return std::exchange(done_, {}); }
-        double heavy_seconds = 0;
+        std::uint64_t heavy_tiles = 0;
 
     private:
         std::uint64_t n_;
-        double heavy_;
         std::vector<TileReport> done_;
-    } work(n, heavy);
+    } work(n);
     std::uint64_t reported = 0;
     const TilesDone done = [&](std::span<const TileReport> tiles, int) { reported += tiles.size(); };
-    world.barrier();
-    const double start = seconds();
     const ScheduleResult r = run_schedule(world, pending, work, done, [] { return false; }, settings_of(GetParam()));
-    const double took = seconds() - start;
     EXPECT_FALSE(r.interrupted);
     if (world.is_root()) {
         EXPECT_EQ(reported, n);
     }
-    double all_heavy = 0;
-    mpi::check(MPI_Allreduce(&work.heavy_seconds, &all_heavy, 1, MPI_DOUBLE, MPI_SUM, world.get()), "MPI_Allreduce");
-    if (computing < 2) return;  // nobody to take tiles
-    const double ideal = all_heavy / computing;
-    const double first_block = all_heavy / static_cast<double>(n / 4) * static_cast<double>(n / (2 * static_cast<std::uint64_t>(computing)));
-    // Before the first block alone would end (ideal: half that).
-    EXPECT_LT(took, 0.9 * first_block) << "ideal " << ideal << " s; the first block alone takes " << first_block
-                                      << " s; this rank computed " << r.stats.tiles << " tiles in " << r.stats.blocks
-                                      << " blocks, gave back " << r.stats.given_back;
+    std::uint64_t most = 0;
+    mpi::check(MPI_Allreduce(&work.heavy_tiles, &most, 1, MPI_UINT64_T, MPI_MAX, world.get()), "MPI_Allreduce");
+    if (computing < 2) return;  // nobody to share with
+    // The first block holds the 50 costly tiles; shared fairly, each rank computes 50 / computing
+    // (a margin for the load of this machine, where probes yield the core to other ranks).
+    EXPECT_LE(most, 40u) << "a rank computed " << most << " of the " << n / 8 << " costly tiles; it gave back "
+                         << r.stats.given_back;
 }
 
 }  // namespace
