@@ -170,6 +170,7 @@ private:
         std::uint64_t weight = 1;
         std::uint64_t unstarted = 0;  // tiles it holds and has not started, as last heard
         std::uint64_t assigned = 0;   // tiles assigned to it so far
+        std::uint64_t in_flight = 0;  // of which it had not received when it last wrote
         std::uint64_t idle = 0;       // ranks under it with nothing to compute, as last heard
         bool active = true;           // no final message yet
         bool stop_sent = false;
@@ -253,6 +254,13 @@ private:
             if (c.active) n += c.unstarted;
         }
         return n;
+    }
+
+    // Some rank served here holds, or is about to receive, tiles it could give back.
+    bool splittable_below() const
+    {
+        return std::any_of(children_.begin(), children_.end(),
+                           [](const Child& c) { return c.active && c.unstarted + c.in_flight >= 2; });
     }
 
     // The second half of this rank's own unstarted tiles (the end of its queue, then the
@@ -402,7 +410,8 @@ private:
         ++stats.messages_in;
         const std::uint64_t flags = msg[0];
         c.weight = msg[1];
-        c.unstarted = msg[2] + (c.assigned - msg[3]);
+        c.unstarted = msg[2];
+        c.in_flight = c.assigned - msg[3];
         c.idle = msg[4];
         const std::uint64_t groups = msg[5];
         std::size_t at = 6;
@@ -446,8 +455,8 @@ private:
         if (pool_tiles_ > 0) {
             const Range r = take(block_for(c.weight));
             stats.handed_out.push_back(r.count);
-            c.unstarted += r.count;
             c.assigned += r.count;
+            c.in_flight += r.count;
             send_down(c, Down::assign, r);
         } else {
             c.waiting = true;  // answered when tiles come: from this server's server, or given back
@@ -533,6 +542,7 @@ private:
         if (!best) return false;
         Child& c = children_[static_cast<std::size_t>(best - children_.data())];
         c.asked_back = true;
+        ++stats.asked_back;
         send_down(c, Down::give_back);
         return true;
     }
@@ -580,7 +590,7 @@ private:
         }
         while (asked < waiting && ask_back()) ++asked;
         // Someone can still give tiles back: the waiting ranks wait for them.
-        if (asked > 0 || owe_back_ || fullest_child() || current_.count >= 2) return;
+        if (asked > 0 || owe_back_ || splittable_below() || current_.count >= 2) return;
         for (Child& c : children_) {
             if (c.active && c.waiting) {
                 c.waiting = false;

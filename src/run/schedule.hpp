@@ -98,6 +98,7 @@ struct ScheduleStats {
     // ranks it serves and for itself, in order.
     std::vector<std::uint64_t> handed_out;
     std::uint64_t given_back = 0;    // tiles it gave back (to its server, or to its own pool)
+    std::uint64_t asked_back = 0;    // requests for tiles back it sent to the ranks it serves
     double idle_seconds = 0;         // time it waited with nothing to compute (or to serve)
     bool two_level = false;          // node leaders were used (same on every rank)
     bool leader = false;             // this rank served a node (rank 0 included)

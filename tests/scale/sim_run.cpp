@@ -9,7 +9,7 @@
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
 //       [--fs-latency 1e-3] [--flush-bytes 8388608] [--journal-seconds 10]
-//       [--compress-mbps 100] [--compress-ratio 100] [--no-io]
+//       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--pieces 4]
 #include <fcntl.h>
 #include <mpi.h>
 #include <smpi/smpi.h>
@@ -93,6 +93,7 @@ struct Options {
     double compress_mbps = 100;    // shuffle + deflate, per core
     double compress_ratio = 100;
     bool io = true;
+    std::uint64_t pieces = 4;      // most pieces a tile is computed in, where the rank serves no one
 };
 
 Options parse(int argc, char** argv)
@@ -115,6 +116,7 @@ Options parse(int argc, char** argv)
         else if (a == "--compress-mbps") o.compress_mbps = std::stod(value());
         else if (a == "--compress-ratio") o.compress_ratio = std::stod(value());
         else if (a == "--no-io") o.io = false;
+        else if (a == "--pieces") o.pieces = std::stoull(value());
         else if (o.costs.empty() && a.rfind("--", 0) != 0) o.costs = a;
         else throw std::runtime_error("unknown argument " + a);
     }
@@ -155,14 +157,14 @@ private:
 
 // Counting replaced by smpi_execute of the tile's modelled cost, in pieces with the Serve
 // callback between them as the real counter calls it every 512 points (at most 8 pieces on
-// a rank that serves others, 4 elsewhere, to keep the simulation's events few: answers
-// come later than in the real run, never sooner);
+// a rank that serves others, --pieces elsewhere, to keep the simulation's events few:
+// answers come later than in the real run, never sooner);
 // writing by the writer's model: tiles buffered until ~8 MiB or a flush, then per run of
 // consecutive tiles one write to /wall_bounces and one to /outcome.
 class ModelWork final : public TileWork {
 public:
     ModelWork(const Costs& c, FileSystem& fs, const Options& o, bool serves)
-        : costs_(c), fs_(fs), flush_bytes_(o.flush_bytes), serves_(serves)
+        : costs_(c), fs_(fs), flush_bytes_(o.flush_bytes), serves_(serves), pieces_(o.pieces)
     {
     }
 
@@ -170,7 +172,7 @@ public:
     {
         const double cost = costs_.cost(tile);
         const std::uint64_t points = costs_.tile_points(tile);
-        const int pieces = static_cast<int>(std::clamp<std::uint64_t>(points / 512, 1, serves_ ? 8 : 4));
+        const int pieces = static_cast<int>(std::clamp<std::uint64_t>(points / 512, 1, serves_ ? 8 : pieces_));
         for (int i = 0; i < pieces; ++i) {
             smpi_execute(cost / pieces);
             serve();
@@ -222,6 +224,7 @@ private:
     FileSystem& fs_;
     double flush_bytes_;
     bool serves_;
+    std::uint64_t pieces_;
     std::vector<std::pair<std::uint64_t, std::uint64_t>> runs_;  // [first, end) of consecutive tiles
     std::vector<std::uint64_t> run_points_;
     std::vector<std::uint64_t> buffered_;
@@ -309,12 +312,13 @@ int run(int argc, char** argv)
         const double ideal = total / ranks;
         std::printf("ranks=%d efficiency=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "
                     "finish_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu root_messages=%llu "
-                    "max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f idle_s_per_rank=%.6g\n",
+                    "max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f root_asked_back=%llu idle_s_per_rank=%.6g\n",
                     ranks, ideal / predicted, predicted, ideal, total, schedule_s, end - scheduled,
                     last_busy - first_idle, static_cast<unsigned long long>(costs.tiles()),
                     static_cast<unsigned long long>(r.stats.requests_in),
                     static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(),
-                    ops, r.stats.two_level ? 1 : 0, given_back, idle / ranks);
+                    ops, r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back),
+                    idle / ranks);
         std::fflush(stdout);
     }
     return 0;

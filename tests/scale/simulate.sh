@@ -59,7 +59,7 @@ for ((i = 0; i < 128; i++)); do echo "node-$i:32"; done >"$out/hosts"
 # shellcheck source=calibration.env
 source tests/scale/calibration.env
 smpi=(--cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no
-      --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no)
+      --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536)
 
 for job in "${jobs[@]}"; do
   name=$(basename "$job" .toml)

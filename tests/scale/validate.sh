@@ -71,7 +71,7 @@ predicted() {  # schedule_s of the simulation: NAME JOB RANKS
   echo "node-0:$3" >"$out/hosts"
   smpirun -np "$3" -platform tests/scale/local.xml -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$1.$3.bin" \
     --node-ranks "$3" --no-io --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no \
-    --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no 2>"$out/$1.$3.log" |
+    --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536 2>"$out/$1.$3.log" |
     sed -n 's/.* schedule_s=\([^ ]*\).*/\1/p'
   rm -f "$out/$1.$3.bin"
 }
