@@ -30,7 +30,6 @@ from superball_results import (  # noqa: E402  (needs the path above)
     parse_size,
     pyplot,
     run_script,
-    warn,
     warn_if_incomplete,
 )
 
@@ -176,7 +175,8 @@ def read_map(result, fixed, stride):
     index = tuple(fixed[dim] if dim in fixed else every for dim in range(len(result.axis_names)))
     names = [name for dim, name in enumerate(result.axis_names) if dim not in fixed]
     samples = [result.axes[name][every] for name in names]
-    return result.counts[index], result.outcomes[index], names, samples
+    counts, outcomes = result.read(index)
+    return counts, outcomes, names, samples
 
 
 def count_bins(values, max_classes):
@@ -258,11 +258,7 @@ def bin_label(low, high, last):
 
 
 def outcome_classes(outcomes):
-    """Outcome codes as class indices into OUTCOME_COLOURS; unknown codes are warned about and shown as invalid."""
-    unknown = outcomes >= len(OUTCOME_NAMES)
-    if unknown.any():
-        warn(f"{int(unknown.sum())} points have outcome codes outside 0..3; shown as invalid")
-        outcomes = np.where(unknown, INVALID, outcomes)
+    """Outcome codes as class indices into OUTCOME_COLOURS (Result.read has checked them: 0 to 3)."""
     return outcomes.astype(np.intp)
 
 
@@ -398,10 +394,10 @@ def main(argv=None):
     args = parse_args(argv)
     with Result(args.result) as result:
         fixed = resolve_slices(result, args.slice)
-        warn_if_incomplete(result)
         plotted_sizes = [n for dim, n in enumerate(result.shape) if dim not in fixed]
         stride = args.stride or (1 if args.bare else max(1, math.ceil(max(plotted_sizes) / MAX_FIGURE_SAMPLES)))
         counts, outcomes, names, samples = read_map(result, fixed, stride)
+        warn_if_incomplete(result)
         output = args.output or default_output(args, result, fixed)
 
         classes = CountClasses(counts, outcomes, args.max_classes)

@@ -23,6 +23,7 @@ from superball_results import (  # noqa: E402  (needs the path above)
     iter_blocks,
     join_values,
     run_script,
+    warn_if_incomplete,
 )
 
 # Points read at once (np.bincount widens them to 64-bit: 32 MiB per block).
@@ -62,13 +63,10 @@ def histograms(result, block_points):
     counts = np.zeros(0, dtype=np.int64)
     outcomes = np.zeros(len(OUTCOME_NAMES), dtype=np.int64)
     for index in iter_blocks(result.shape, block_points):
-        counts = add_counts(counts, result.counts[index])
-        outcomes = add_counts(outcomes, result.outcomes[index])
+        block_counts, block_outcomes = result.read(index)
+        counts = add_counts(counts, block_counts)
+        outcomes = add_counts(outcomes, block_outcomes)
     return counts, outcomes
-
-
-def outcome_name(code):
-    return OUTCOME_NAMES[code] if code < len(OUTCOME_NAMES) else f"unknown code {code}"
 
 
 def summarise(result, block_points):
@@ -98,9 +96,8 @@ def summarise(result, block_points):
             if c
         ],
         "outcome": [
-            {"outcome": outcome_name(code), "code": code, "points": int(c), "fraction": int(c) / points}
+            {"outcome": OUTCOME_NAMES[code], "code": code, "points": int(c), "fraction": int(c) / points}
             for code, c in enumerate(outcomes)
-            if c or code < len(OUTCOME_NAMES)
         ],
     }
 
@@ -142,6 +139,7 @@ def main(argv=None):
         parser.error(f"--block {args.block} is out of range: accepted >= 1")
     with Result(args.result) as result:
         summary = summarise(result, args.block)
+        warn_if_incomplete(result)
     print(json.dumps(summary, indent=2) if args.json else report(summary))
     return 0
 

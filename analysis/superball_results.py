@@ -1,6 +1,6 @@
 """Shared helpers of the superball analysis scripts.
 
-Reading a result file (SPEC.md section 5) in one place keeps the scripts agreeing
+Reading a result file (src/io/layout.hpp) in one place keeps the scripts agreeing
 on what its attributes mean, how axes are named and labelled, and how a title
 describes a map; the command-line plumbing (errors, exit statuses, figure sizes)
 lives here for the same reason.  Only numpy and h5py are imported at module
@@ -8,6 +8,8 @@ level so that non-plotting scripts (summary.py) stay light: plotting scripts
 get matplotlib through `pyplot()`.
 """
 
+import itertools
+import math
 import os
 import sys
 
@@ -31,9 +33,6 @@ AXIS_LABELS = {
     "v": "v [m/s]",
     "omega": "omega [rad/s]",
 }
-
-# Model attributes shown in titles and summaries, in this order when present.
-MODEL_ATTRIBUTES = ("e_wall", "alpha_wall", "e_floor", "alpha_floor", "g", "radius")
 
 # Exit statuses of SPEC.md section 6.
 EXIT_BAD_INPUT = 2
@@ -72,6 +71,26 @@ def run_script(main):
         print(f"{prog}: error: {error}", file=sys.stderr)
         status = EXIT_FAILURE
     sys.exit(status or 0)
+
+
+def run_superball(command, arguments):
+    """Standard output of `superball COMMAND ARGUMENTS` (the binary from $SUPERBALL, else
+    `superball` on PATH); a leading COMMAND in ARGUMENTS is dropped. A failure becomes a
+    ScriptError with the binary's message and its status (1 or 2)."""
+    import shutil
+    import subprocess
+
+    binary = os.environ.get("SUPERBALL") or shutil.which("superball")
+    if not binary:
+        raise ScriptError("cannot find the superball binary: set SUPERBALL or put superball on PATH", EXIT_FAILURE)
+    if arguments and arguments[0] == command:
+        arguments = arguments[1:]
+    argv = [binary, command] + list(arguments)
+    process = subprocess.run(argv, capture_output=True, text=True)
+    if process.returncode != 0:
+        status = process.returncode if process.returncode in (1, 2) else EXIT_FAILURE
+        raise ScriptError(f"{' '.join(argv)} failed: {process.stderr.strip()}", status)
+    return process.stdout
 
 
 def warn(message):
@@ -165,64 +184,625 @@ def iter_blocks(shape, max_elements):
             yield tuple(lead) + (slice(start, min(start + run, shape[cut])),) + rest
 
 
-class Result:
-    """An open result file (SPEC.md section 5): layout checked, axes and attributes decoded.
+# The file layout (src/io/layout.hpp): what superball 0.2 writes and this module reads.
+FORMAT_VERSION = 2
+KIND_RESULT, KIND_PARTIAL = "result", "partial"
+COEFFICIENT_NAMES = ("e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor")
+# Limits of a sound file, as the C++ reader's (src/io/result_reader.cpp): beyond 2^40
+# points a file is damaged, not big; a job file is a few hundred bytes.
+MAX_POINTS = 1 << 40
+MAX_TEXT_BYTES = 4096
+MAX_JOB_BYTES = 1 << 20
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+# Errors h5py raises on a file whose structure or data HDF5 cannot read.
+H5PY_ERRORS = (OSError, KeyError, ValueError, TypeError, RuntimeError, IndexError)
 
-    The two big datasets are left on disk (`counts`, `outcomes` are h5py datasets)
-    so that callers read only the slices or blocks they need.
+
+def describe_file(path):
+    """What is at `path`, for messages: 'a directory', 'an empty file', 'a text file of ...'."""
+    if os.path.isdir(path):
+        return "a directory"
+    if not os.path.isfile(path):
+        return "not a regular file"
+    size = os.path.getsize(path)
+    if size == 0:
+        return "an empty file"
+    try:
+        with open(path, "rb") as f:
+            head = f.read(512)
+    except OSError as error:
+        return f"a file that cannot be read ({error.strerror})"
+    if is_hdf5(path):
+        return "an HDF5 file"
+    if all(b >= 0x20 or b in b"\n\r\t" for b in head):
+        first = head.split(b"\n", 1)[0][:40].decode("utf-8", "backslashreplace")
+        return f'a text file of {size} bytes, beginning "{printable(first)}"'
+    return f"a binary file of {size} bytes"
+
+
+def is_hdf5(path):
+    """True if the file begins with HDF5's signature (at 0, 512, 1024, ...: after a user block)."""
+    with open(path, "rb") as f:
+        at = 0
+        while at < (1 << 30):
+            f.seek(at)
+            head = f.read(8)
+            if len(head) < 8:
+                return False
+            if head == HDF5_SIGNATURE:
+                return True
+            at = 512 if at == 0 else 2 * at
+    return False
+
+
+def printable(text, limit=60):
+    """A text of a file, for a message: at most `limit` characters, with control characters
+    escaped, so that a damaged file cannot garble a terminal (as the
+    C++ reader's messages)."""
+    out = []
+    for ch in str(text)[:limit]:
+        if ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\x{ord(ch):02x}")
+        elif not ch.isprintable():
+            out.append(ch.encode("unicode_escape").decode("ascii"))
+        else:
+            out.append(ch)
+    return "".join(out) + ("..." if len(str(text)) > limit else "")
+
+
+GLOBAL_HEAP_SIGNATURE = b"GCOL\x01\x00\x00\x00"
+
+
+def damaged_global_heap(path, skip):
+    """The offset of the first damaged global heap collection of the file, or None.
+
+    HDF5 1.10 keeps variable-length values (texts, DIMENSION_LIST) in global heap
+    collections, which have no checksum, and trusts the sizes of their objects: a damaged
+    size makes it copy past its buffers when the values are read (a crash or a hang, not
+    an error).  Each collection found outside the byte ranges `skip` (raw data, (offset,
+    size)) is walked as HDF5 walks it (src/io/hdf5.cpp: damaged_global_heap, the same).
+    """
+    size = os.path.getsize(path)
+    block = 16 << 20
+    with open(path, "rb") as f:
+        def intact(at):
+            f.seek(at)
+            header = f.read(16)
+            if len(header) < 16:
+                return False
+            total = int.from_bytes(header[8:16], "little")
+            if total < 4096 or total > size - at or total > (1 << 30):
+                return False
+            f.seek(at)
+            heap = f.read(total)
+            seen, p = set(), 16
+            while p < total and total - p >= 16:
+                index = int.from_bytes(heap[p:p + 2], "little")
+                length = int.from_bytes(heap[p + 8:p + 16], "little")
+                if length > total:
+                    return False
+                need = 16 + (length + 7) // 8 * 8 if index else length
+                if need < 16 or need > total - p or (index and index in seen):
+                    return False
+                seen.add(index)
+                p += need
+            return len(heap) == total
+
+        def scan(start, stop):
+            pos = start
+            while pos < stop:
+                f.seek(pos)
+                data = f.read(min(block, stop - pos))
+                at = data.find(GLOBAL_HEAP_SIGNATURE)
+                while at >= 0:
+                    if not intact(pos + at):
+                        return pos + at
+                    at = data.find(GLOBAL_HEAP_SIGNATURE, at + 1)
+                if len(data) < block:
+                    return None
+                pos += block - (len(GLOBAL_HEAP_SIGNATURE) - 1)
+            return None
+
+        start = 0
+        for offset, length in sorted(skip):
+            if offset > start:
+                bad = scan(start, min(offset, size))
+                if bad is not None:
+                    return bad
+            start = max(start, offset + length)
+        return scan(start, size) if start < size else None
+
+
+def raw_data_ranges(file):
+    """Byte ranges (offset, size) of a file's big raw data, which damaged_global_heap need
+    not search: contiguous datasets, and chunked ones without filters whose chunks lie one
+    after the other (a partial file's)."""
+    ranges = []
+    for name in ("wall_bounces", "outcome", "progress/tile_done", "progress/tile_checksum"):
+        try:
+            dataset = file.get(name)
+            if not isinstance(dataset, h5py.Dataset) or 0 in (dataset.shape or (0,)):
+                continue
+            plist = dataset.id.get_create_plist()
+            if plist.get_layout() != h5py.h5d.CHUNKED:
+                offset = dataset.id.get_offset()
+                if offset is not None:
+                    ranges.append((offset, dataset.id.get_storage_size()))
+                continue
+            if plist.get_nfilters():
+                continue
+            chunk = plist.get_chunk()
+            chunks = math.prod(-(-n // c) for n, c in zip(dataset.shape, chunk))
+            if dataset.id.get_num_chunks() != chunks:
+                continue
+            chunk_bytes = dataset.id.get_type().get_size() * math.prod(chunk)
+            first = dataset.id.get_chunk_info_by_coord((0,) * len(chunk)).byte_offset
+            last = dataset.id.get_chunk_info_by_coord(tuple((n - 1) // c * c for n, c in zip(dataset.shape, chunk)))
+            if last.byte_offset == first + (chunks - 1) * chunk_bytes:
+                ranges.append((first, chunks * chunk_bytes))
+        except H5PY_ERRORS:
+            pass
+    return ranges
+
+
+def shape_text(type_class, shape):
+    """What an attribute or dataset holds: 'a text', 'a list of 2 integers', ..."""
+    kind = {h5py.h5t.STRING: "text", h5py.h5t.INTEGER: "integer", h5py.h5t.FLOAT: "floating-point number"}.get(
+        type_class, "value of another type")
+    if shape == ():
+        return f"{'an' if kind == 'integer' else 'a'} {kind}"
+    if shape is None or 0 in shape:
+        return "empty"
+    if len(shape) == 1:
+        return f"a list of {shape[0]} {kind}s"
+    return f"an array ({', '.join(map(str, shape))}) of {kind}s"
+
+
+class Result:
+    """An open superball file, result or partial (src/io/layout.hpp), validated as it is read.
+
+    Opening checks the structure as the C++ reader does (src/io/result_reader.cpp): the
+    kind and format, every attribute's type, shape and range, the data's types and shapes,
+    the coordinate variables and their dimension scales, a partial file's tiling and
+    journal; anything wrong is a ScriptError naming the file and the object.  `read()`
+    checks the values it returns (outcome codes, counts against max_bounces, a partial
+    file's tiles against their checksums) and reads the points of tiles not yet done as
+    invalid; a partial file is announced with a warning.  The two big datasets stay on
+    disk (`counts`, `outcomes` are h5py datasets): callers read the blocks they need.
     """
 
     def __init__(self, path):
         self.path = path
         if not os.path.exists(path):
-            raise ScriptError(f"result file {path!r} does not exist")
+            raise ScriptError(f"{path}: no such file")
+        if not os.path.isfile(path):
+            raise ScriptError(f"{path} is {describe_file(path)}, not a superball file")
+        try:
+            hdf5 = is_hdf5(path)
+        except OSError as error:
+            raise ScriptError(f"{path} cannot be read ({error.strerror})")
+        if not hdf5:
+            raise ScriptError(f"{path} is {describe_file(path)}, not a superball result")
         try:
             self.file = h5py.File(path, "r")
-        except OSError as error:
+        except H5PY_ERRORS as error:
             hint = ""
             if "lock" in str(error).lower():
                 hint = "; a run still writing it locks it: wait, or set HDF5_USE_FILE_LOCKING=FALSE to peek"
-            raise ScriptError(f"cannot open {path!r} as an HDF5 result ({error}){hint}")
+            raise ScriptError(f"{path} is an HDF5 file that cannot be opened, damaged or truncated ({error}){hint}")
         try:
-            self._check_layout()
+            # Before any text is read: HDF5 reads variable-length values without checking them.
+            bad = damaged_global_heap(path, raw_data_ranges(self.file))
+            if bad is not None:
+                self.fail(f"the global heap at byte {bad} (where HDF5 keeps texts and dimension-scale lists) is "
+                          "damaged: its objects do not fit it")
+            self._validate()
         except ScriptError:
             self.file.close()
             raise
+        except H5PY_ERRORS as error:
+            self.file.close()
+            raise ScriptError(f"{path} is damaged: {error}")
+        self._verified = np.zeros(self.tile_count, dtype=bool)
+        self._checksums_unchecked = False
 
-    def _check_layout(self):
-        """Fail early, naming the missing piece, rather than deep inside a plot."""
-        for name in ("wall_bounces", "outcome"):
-            if not isinstance(self.file.get(name), h5py.Dataset):
-                raise ScriptError(f"{self.path}: dataset /{name} is missing (not a superball result?)")
-        self.counts = self.file["wall_bounces"]
-        self.outcomes = self.file["outcome"]
-        if self.counts.shape != self.outcomes.shape:
-            raise ScriptError(
-                f"{self.path}: /wall_bounces {self.counts.shape} and /outcome {self.outcomes.shape} differ in shape"
-            )
-        self.attrs = {key: decode(value) for key, value in self.file.attrs.items()}
-        self.axis_names = self._axis_names()
-        if len(self.axis_names) != self.counts.ndim:
-            raise ScriptError(
-                f"{self.path}: {self.counts.ndim}-D data but axis_names lists {len(self.axis_names)} "
-                f"axes ({', '.join(self.axis_names)})"
-            )
+    # --- structure ----------------------------------------------------------------------
+
+    def fail(self, what):
+        raise ScriptError(f"{self.path}: {what}")
+
+    def _attribute(self, name, obj=None):
+        """(type class, shape, type) of an attribute, or a refusal naming it if it is missing."""
+        obj = self.file if obj is None else obj
+        if name not in obj.attrs:
+            self.fail(f"attribute {name} is missing")
+        attribute = h5py.h5a.open(obj.id, name.encode())
+        kind = attribute.get_type()
+        space = attribute.get_space().get_simple_extent_type()
+        shape = None if space == h5py.h5s.NULL else attribute.shape
+        return kind.get_class(), shape, kind
+
+    def _read_attribute(self, name, obj=None):
+        return (self.file if obj is None else obj).attrs[name]
+
+    def _text(self, name, max_bytes=MAX_TEXT_BYTES, obj=None):
+        type_class, shape, kind = self._attribute(name, obj)
+        if type_class != h5py.h5t.STRING or shape != ():
+            self.fail(f"attribute {name} is {shape_text(type_class, shape)}, not a text")
+        if not kind.is_variable_str() and kind.get_size() > max_bytes:
+            self._too_long(name, kind.get_size(), max_bytes)
+        value = self._read_attribute(name, obj)
+        value = value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+        value = value.split("\0", 1)[0]
+        if len(value.encode("utf-8", "replace")) > max_bytes:
+            self._too_long(name, len(value.encode("utf-8", "replace")), max_bytes)
+        return value
+
+    def _too_long(self, name, size, max_bytes):
+        self.fail(f"attribute {name} holds a text of {size} bytes: accepted at most {max_bytes}")
+
+    def _integer(self, name, low, high):
+        type_class, shape, _ = self._attribute(name)
+        if type_class != h5py.h5t.INTEGER or shape != ():
+            self.fail(f"attribute {name} is {shape_text(type_class, shape)}, not an integer")
+        value = int(self._read_attribute(name))
+        if not low <= value <= high:
+            self.fail(f"attribute {name} = {value} is out of range: accepted {low} to {high}")
+        return value
+
+    def _number(self, name):
+        type_class, shape, _ = self._attribute(name)
+        if type_class not in (h5py.h5t.INTEGER, h5py.h5t.FLOAT) or shape != ():
+            self.fail(f"attribute {name} is {shape_text(type_class, shape)}, not a number")
+        value = float(self._read_attribute(name))
+        if not math.isfinite(value):
+            self.fail(f"attribute {name} = {value} is not finite")
+        return value
+
+    def _texts(self, name, max_items):
+        type_class, shape, kind = self._attribute(name)
+        if type_class != h5py.h5t.STRING or shape is None or len(shape) != 1:
+            self.fail(f"attribute {name} is {shape_text(type_class, shape)}, not a list of texts")
+        if not 1 <= shape[0] <= max_items:
+            self.fail(f"attribute {name} lists {shape[0]} items: accepted 1 to {max_items}")
+        if not kind.is_variable_str() and kind.get_size() > MAX_TEXT_BYTES:
+            self._too_long(name, kind.get_size(), MAX_TEXT_BYTES)
+        values = [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v)
+                  for v in self._read_attribute(name).tolist()]
+        for value in values:
+            if len(value.encode("utf-8", "replace")) > MAX_TEXT_BYTES:
+                self._too_long(name, len(value.encode("utf-8", "replace")), MAX_TEXT_BYTES)
+        return [v.split("\0", 1)[0] for v in values]
+
+    def _integers(self, name, items):
+        type_class, shape, _ = self._attribute(name)
+        if type_class != h5py.h5t.INTEGER or shape is None or len(shape) != 1:
+            self.fail(f"attribute {name} is {shape_text(type_class, shape)}, not a list of integers")
+        if shape[0] != items:
+            self.fail(f"attribute {name} lists {shape[0]} integers for {items} dimensions")
+        return [int(v) for v in self._read_attribute(name).tolist()]
+
+    def _dataset(self, name):
+        dataset = self.file.get(name)
+        if not isinstance(dataset, h5py.Dataset):
+            self.fail(f"{name} is missing or not a dataset")
+        return dataset
+
+    @staticmethod
+    def _type(dataset):
+        """(type class, bytes, signed, little-endian) of a dataset's elements."""
+        kind = dataset.id.get_type()
+        type_class = kind.get_class()
+        signed = type_class == h5py.h5t.INTEGER and kind.get_sign() == h5py.h5t.SGN_2
+        little = type_class not in (h5py.h5t.INTEGER, h5py.h5t.FLOAT) or kind.get_order() == h5py.h5t.ORDER_LE
+        return type_class, kind.get_size(), signed, little
+
+    def _allocated(self, dataset, name):
+        """Refuses a dataset part of whose data has no storage (HDF5 would read zeros)."""
+        plist = dataset.id.get_create_plist()
+        size = dataset.id.get_type().get_size()
+        if plist.get_layout() == h5py.h5d.CHUNKED:
+            chunks = plist.get_chunk()
+            expected = int(np.prod([-(-n // c) for n, c in zip(dataset.shape, chunks)], dtype=np.int64))
+            whole = dataset.id.get_num_chunks() == expected
+        else:
+            whole = dataset.id.get_storage_size() == int(np.prod(dataset.shape, dtype=np.int64)) * size
+        if not whole:
+            self.fail(f"{name} lacks storage for part of its data: the file is incomplete or damaged")
+
+    def _validate(self):
+        attrs = self.file.attrs
+        if "superball_file" not in attrs:
+            if "superball_format" in attrs or "coordinate_system" in attrs:
+                self.fail("attribute superball_file is missing")  # a file of this layout, damaged
+            if "job_toml" in attrs and "software_version" in attrs:
+                try:
+                    version = decode(attrs["software_version"])
+                except H5PY_ERRORS:
+                    version = "?"
+                self.fail(f"written by superball {printable(version)} in the layout before netCDF conventions, which this "
+                          "version does not read; run the job again with this version")
+            self.fail("an HDF5 file that is not a superball result (no attribute superball_file)")
+        self.kind = self._text("superball_file")
+        if self.kind not in (KIND_RESULT, KIND_PARTIAL):
+            self.fail(f'attribute superball_file = "{printable(self.kind)}" is neither "result" nor "partial"')
+        version = self._integer("superball_format", 0, 2**63 - 1)
+        if version != FORMAT_VERSION:
+            self.fail(f"attribute superball_format = {version}: this version of superball reads format "
+                      f"{FORMAT_VERSION} only; read the file with the version that wrote it")
+
+        self.coordinates = self._text("coordinate_system")
+        if self.coordinates not in COORDINATE_NAMES:
+            self.fail(f'attribute coordinate_system = "{printable(self.coordinates)}" is neither canonical nor physical')
+        coordinates = COORDINATE_NAMES[self.coordinates]
+        self.axis_names = self._texts("axis_names", 4)
+        last = -1
+        for i, name in enumerate(self.axis_names):
+            if name not in coordinates and name not in COEFFICIENT_NAMES:
+                self.fail(f'attribute axis_names names "{printable(name)}", which is neither a {self.coordinates} coordinate '
+                          f"({', '.join(coordinates)}) nor a model coefficient ({', '.join(COEFFICIENT_NAMES)})")
+            if name in self.axis_names[:i]:
+                self.fail(f'attribute axis_names names "{name}" twice')
+            order = coordinates.index(name) if name in coordinates else -1
+            if order < last:
+                self.fail(f"attribute axis_names lists ({', '.join(map(printable, self.axis_names))}) out of order: swept "
+                          f"coefficients first, then {', '.join(coordinates)}")
+            last = max(last, order)
+        self._fixed = {c: self._number(f"fixed_{c}") for c in coordinates if c not in self.axis_names}
+        if len(coordinates) - len(self._fixed) > 3:
+            self.fail(f"attribute axis_names lists {len(coordinates) - len(self._fixed)} {self.coordinates} "
+                      "coordinates: a grid has at most 3 ranges")
+
+        self.max_bounces = self._integer("max_bounces", 1, 2**32 - 1)
+        self.software_version = self._text("software_version")
+        self.job_toml = self._text("job_toml", MAX_JOB_BYTES)
+        self._text("job_fingerprint", MAX_JOB_BYTES)
+        self._integer("mpi_ranks", 0, 1 << 40)
+        if self._number("wall_seconds") < 0:
+            self.fail(f"attribute wall_seconds = {self._number('wall_seconds')} is negative")
+        complete = self._integer("complete", 0, 1) == 1
+        if self.kind == KIND_RESULT and not complete:
+            self.fail("attribute complete = 0 contradicts superball_file = result (a result is written complete)")
+        if self.kind == KIND_PARTIAL and complete:
+            self.fail("attribute complete = 1 contradicts superball_file = partial (a run in progress)")
+        self._model = {}
+        swept = set()
+        for key in ("e_wall", "alpha_wall", "e_floor", "alpha_floor"):
+            if key in attrs and self._attribute(key)[0] == h5py.h5t.STRING:
+                value = self._text(key)
+                axis = value[5:] if value.startswith("axis:") else ""
+                if axis not in self.axis_names or axis not in (key, key.split("_")[0]):
+                    self.fail(f'attribute {key} = "{printable(value)}" names no axis of the file that sweeps {key}')
+                swept.add(axis)
+                self._model[key] = value
+                continue
+            value = self._number(key)
+            if not (0 < value <= 1 if key.startswith("e") else -1 <= value <= 1):
+                accepted = "0 < e <= 1" if key.startswith("e") else "-1 <= alpha <= 1"
+                self.fail(f"attribute {key} = {format_number(value)} is out of range: accepted {accepted}")
+            self._model[key] = value
+        for name in self.axis_names:
+            if name in COEFFICIENT_NAMES and name not in swept:
+                self.fail(f'attribute axis_names names the coefficient {name}, but no coefficient attribute says '
+                          f'"axis:{name}"')
+        if self.coordinates == "physical":
+            for key in ("g", "radius"):
+                value = self._number(key)
+                if not value > 0:
+                    self.fail(f"attribute {key} = {format_number(value)} is out of range: accepted > 0")
+                self._model[key] = value
+
+        self._validate_data()
+        if self.kind == KIND_PARTIAL:
+            self._validate_partial()
+        else:
+            self.tile_shape, self.tile_count, self.tiles_done, self._done = None, 1, 1, None
+            if "progress" in self.file:
+                journal = " (/progress), which only a run in progress has"
+                flags = self.file.get("progress/tile_done")
+                if isinstance(flags, h5py.Dataset) and flags.dtype.kind in "ui" and flags.ndim == 1:
+                    flags = flags[()]
+                    journal = f", /progress/tile_done, recording {int(np.count_nonzero(flags == 1))} of {flags.size} tiles done"
+                self.fail("superball_file = result and complete = 1 say the run is complete, but the file holds a "
+                          f"resume journal{journal}: the file contradicts itself")
+
+    def _validate_data(self):
+        self.counts = self._dataset("/wall_bounces")
+        self.outcomes = self._dataset("/outcome")
+        partial = self.kind == KIND_PARTIAL
+        type_class, size, signed, little = self._type(self.counts)
+        if type_class != h5py.h5t.INTEGER or signed or size not in (2, 4) or not (little or not partial):
+            detail = f" of {8 * size} bits, {'signed' if signed else 'unsigned'}" if type_class == h5py.h5t.INTEGER else ""
+            self.fail(f"/wall_bounces holds {shape_text(type_class, self.counts.shape)}{detail}: accepted unsigned 16- "
+                      f"or 32-bit integers{' (little-endian)' if partial else ''}")
+        type_class, size, signed, _ = self._type(self.outcomes)
+        if type_class != h5py.h5t.INTEGER or signed or size != 1:
+            detail = f" of {8 * size} bits, {'signed' if signed else 'unsigned'}" if type_class == h5py.h5t.INTEGER else ""
+            self.fail(f"/outcome holds {shape_text(type_class, self.outcomes.shape)}{detail}: accepted unsigned 8-bit "
+                      "integers")
+        shape, names = self.counts.shape, self.axis_names
+        if shape is None or len(shape) != len(names):
+            dims = "a scalar" if not shape else f"({', '.join(map(str, shape))})"
+            self.fail(f"/wall_bounces has {len(shape or ())} dimensions {dims} but axis_names lists {len(names)} axes "
+                      f"({', '.join(names)})")
+        if self.outcomes.shape != shape:
+            self.fail(f"/outcome {self.outcomes.shape} and /wall_bounces {shape} differ in shape")
+        if 0 in shape:
+            self.fail(f"/wall_bounces {shape} is empty")
+        if math.prod(shape) > MAX_POINTS:
+            self.fail(f"/wall_bounces {shape} has more than 2^40 points")
+        if self.max_bounces > 65535 and self.counts.dtype.itemsize == 2:
+            self.fail(f"max_bounces = {self.max_bounces} does not fit the 16-bit counts of /wall_bounces")
+        self._allocated(self.counts, "/wall_bounces")
+        self._allocated(self.outcomes, "/outcome")
+
+        scales = {name: self._scales(dataset, name) for name, dataset in
+                  (("/wall_bounces", self.counts), ("/outcome", self.outcomes))}
         self.axes = {}
-        for name, n in zip(self.axis_names, self.counts.shape):
-            dataset = self.file.get(f"axes/{name}")
-            if not isinstance(dataset, h5py.Dataset) or dataset.shape != (n,):
-                raise ScriptError(f"{self.path}: /axes/{name} is missing or does not hold {n} samples")
-            self.axes[name] = dataset[()].astype(np.float64)
+        for k, (name, n) in enumerate(zip(names, shape)):
+            variable = f"/{name}"
+            dataset = self._dataset(variable)
+            type_class = self._type(dataset)[0]
+            if type_class != h5py.h5t.FLOAT or dataset.shape != (n,):
+                self.fail(f"{variable} holds {shape_text(type_class, dataset.shape)}, not {n} floating-point samples "
+                          f"(dimension {k} of the data)")
+            self._allocated(dataset, variable)
+            samples = dataset[()].astype(np.float64)
+            bad = np.flatnonzero(~np.isfinite(samples))
+            if bad.size:
+                self.fail(f"{variable} holds {samples[bad[0]]} at {bad[0]}: samples must be finite")
+            bad = np.flatnonzero(~(np.diff(samples) > 0))
+            if bad.size:
+                i = int(bad[0]) + 1
+                self.fail(f"{variable} is not increasing at {i} ({samples[i]} after {samples[i - 1]})")
+            self.axes[name] = samples
+            if "CLASS" not in dataset.attrs or self._text("CLASS", 64, dataset) != "DIMENSION_SCALE":
+                self.fail(f'{variable} is not a dimension scale (its attribute CLASS is not "DIMENSION_SCALE")')
+            address = h5py.h5o.get_info(dataset.id).addr
+            for data_name, attached in scales.items():
+                if address not in attached[k]:
+                    self.fail(f"{variable} is not attached to dimension {k} of {data_name}, which axis_names says is "
+                              f"{name}")
+        for name, value in self._fixed.items():
+            variable = f"/{name}"
+            dataset = self._dataset(variable)
+            type_class = self._type(dataset)[0]
+            if type_class != h5py.h5t.FLOAT or dataset.shape != ():
+                self.fail(f"{variable} holds {shape_text(type_class, dataset.shape)}, not one floating-point number "
+                          f"(the fixed coordinate {name})")
+            self._allocated(dataset, variable)
+            stored = float(dataset[()])
+            if stored != value:
+                self.fail(f"{variable} = {stored!r} contradicts attribute fixed_{name} = {value!r}")
 
-    def _axis_names(self):
-        """Names of the dimensions: attribute axis_names, else the /axes group in SPEC order."""
-        names = self.attrs.get("axis_names")
-        if isinstance(names, str):
-            names = names.replace(",", " ").split()
-        if names is None:
-            present = set(self.file["axes"].keys()) if "axes" in self.file else set()
-            names = [n for system in COORDINATE_NAMES.values() for n in system if n in present]
-        return [str(n) for n in names]
+    def _scales(self, dataset, name):
+        """Addresses of the scales attached to each dimension (attribute DIMENSION_LIST), its type checked first."""
+        if "DIMENSION_LIST" not in dataset.attrs:
+            self.fail(f"{name} has 0 dimension scales attached (attribute DIMENSION_LIST) for its {dataset.ndim} "
+                      "dimensions")
+        kind = h5py.h5a.open(dataset.id, b"DIMENSION_LIST").get_type()
+        if (kind.get_class() != h5py.h5t.VLEN or not kind.get_super().equal(h5py.h5t.STD_REF_OBJ)
+                or dataset.attrs.get_id("DIMENSION_LIST").shape != (dataset.ndim,)):
+            self.fail(f"{name}: attribute DIMENSION_LIST is not a list of object references per dimension")
+        def address(ref):
+            try:
+                return h5py.h5o.get_info(self.file[ref].id).addr
+            except H5PY_ERRORS:
+                return None  # a reference to nothing (the object was deleted) is attached to nothing
+
+        return [{address(ref) for ref in refs} for refs in dataset.attrs["DIMENSION_LIST"]]
+
+    def _validate_partial(self):
+        shape = self.counts.shape
+        self.tile_shape = self._integers("tile_shape", len(shape))
+        if any(not 1 <= t <= n for t, n in zip(self.tile_shape, shape)):
+            self.fail(f"attribute tile_shape = ({', '.join(map(str, self.tile_shape))}) does not fit the data "
+                      f"({', '.join(map(str, shape))})")
+        self._tiles_per_axis = [-(-n // t) for n, t in zip(shape, self.tile_shape)]
+        self.tile_count = math.prod(self._tiles_per_axis)
+        for name, dataset in (("/wall_bounces", self.counts), ("/outcome", self.outcomes)):
+            plist = dataset.id.get_create_plist()
+            chunks = plist.get_chunk() if plist.get_layout() == h5py.h5d.CHUNKED else None
+            if chunks is None or list(chunks) != self.tile_shape or plist.get_nfilters():
+                stored = "unchunked" if chunks is None else f"in chunks of ({', '.join(map(str, chunks))})"
+                if chunks is not None and plist.get_nfilters():
+                    stored += f" through {plist.get_nfilters()} filters"
+                self.fail(f"{name} is stored {stored}, not in uncompressed chunks of tile_shape "
+                          f"({', '.join(map(str, self.tile_shape))}) as a partial file is")
+        journal = {}
+        for name, size in (("/progress/tile_done", 1), ("/progress/tile_checksum", 8)):
+            dataset = self._dataset(name)
+            type_class, bytes_, signed, little = self._type(dataset)
+            if (type_class != h5py.h5t.INTEGER or signed or bytes_ != size or not little
+                    or dataset.shape != (self.tile_count,)):
+                self.fail(f"{name} holds {shape_text(type_class, dataset.shape)} but tile_shape "
+                          f"({', '.join(map(str, self.tile_shape))}) makes {self.tile_count} tiles: accepted "
+                          f"{self.tile_count} unsigned {8 * size}-bit integers, one per tile")
+            self._allocated(dataset, name)
+            journal[name] = dataset[()]
+        self._done = journal["/progress/tile_done"].astype(np.uint8)
+        self._checksums = journal["/progress/tile_checksum"].astype(np.uint64)
+        bad = np.flatnonzero(self._done > 1)
+        if bad.size:
+            self.fail(f"/progress/tile_done holds {self._done[bad[0]]} for tile {bad[0]}: accepted 0 or 1")
+        self.tiles_done = int(np.count_nonzero(self._done))
+
+    # --- values ---------------------------------------------------------------------------
+
+    def read(self, index):
+        """(counts, outcomes) at `index` (a tuple of one int or slice per dimension), as numpy
+        arrays, checked: the points of tiles not done (partial files) read as 0 bounces, outcome
+        invalid; an outcome code outside 0-3, a count its outcome does not allow, a damaged tile
+        or unreadable data is a ScriptError naming the object and the point or tile."""
+        index = tuple(index)
+        try:
+            counts = np.asarray(self.counts[index])
+            outcomes = np.asarray(self.outcomes[index])
+        except H5PY_ERRORS as error:
+            self.fail(f"/wall_bounces or /outcome cannot be read at {index_text(index)} ({error}); the file is damaged")
+        # Per dimension, the file indices the block holds; kept: the dimensions not indexed by an int.
+        positions = [np.arange(n)[i] if isinstance(i, slice) else np.array([int(i) % n])
+                     for i, n in zip(index, self.shape)]
+        expanded = tuple(len(p) for p in positions)
+        counts_full, outcomes_full = counts.reshape(expanded), outcomes.reshape(expanded).copy()
+        if self.kind == KIND_PARTIAL:
+            self._verify_tiles(positions)
+            tiles = [p // t for p, t in zip(positions, self.tile_shape)]
+            flat = np.ravel_multi_index(np.ix_(*tiles), self._tiles_per_axis)
+            missing = self._done[flat] == 0
+            if missing.any():
+                counts_full = np.where(missing, 0, counts_full).astype(counts.dtype)
+                outcomes_full[missing] = INVALID
+        else:
+            missing = None
+        self._check_values(counts_full, outcomes_full, positions, missing)
+        return counts_full.reshape(counts.shape), outcomes_full.reshape(outcomes.shape)
+
+    def _check_values(self, counts, outcomes, positions, missing):
+        def where(flags):
+            at = np.unravel_index(int(np.argmax(flags)), flags.shape)
+            return f"({', '.join(str(int(p[i])) for p, i in zip(positions, at))})"
+
+        bad = outcomes > CAPPED
+        if bad.any():
+            at = np.unravel_index(int(np.argmax(bad)), bad.shape)
+            self.fail(f"/outcome holds {int(outcomes[at])} at {where(bad)}: outcome codes are 0 to 3 "
+                      f"(invalid left missed capped); the file is damaged")
+        bad = np.where(outcomes == INVALID, counts != 0,
+                       np.where(outcomes == CAPPED, counts != self.max_bounces, counts > self.max_bounces))
+        if missing is not None:
+            bad &= ~missing
+        if bad.any():
+            at = np.unravel_index(int(np.argmax(bad)), bad.shape)
+            code = int(outcomes[at])
+            allowed = {INVALID: "0", CAPPED: f"exactly max_bounces = {self.max_bounces}"}.get(
+                code, f"at most max_bounces = {self.max_bounces}")
+            self.fail(f"/wall_bounces holds {int(counts[at])} at {where(bad)} with outcome {code} "
+                      f"({OUTCOME_NAMES[code]}), which allows {allowed}; the file is damaged")
+
+    def _verify_tiles(self, positions):
+        """Checks each done tile the block meets, once, against /progress/tile_checksum."""
+        tiles = [np.unique(p // t) for p, t in zip(positions, self.tile_shape)]
+        for coords in itertools.product(*tiles):
+            tile = int(np.ravel_multi_index(coords, self._tiles_per_axis))
+            if self._done[tile] == 0 or self._verified[tile]:
+                continue
+            origin = tuple(int(c) * t for c, t in zip(coords, self.tile_shape))
+            checksum = tile_checksum(self.counts, self.outcomes, tile, origin)
+            if checksum is None:
+                if not self._checksums_unchecked:
+                    warn(f"python3-xxhash is not installed: the tiles of {self.path} are not checked against their "
+                         "checksums")
+                    self._checksums_unchecked = True
+                return
+            if checksum != int(self._checksums[tile]):
+                spans = ", ".join(f"{name} {o}..{min(o + t, n) - 1}" for name, o, t, n in
+                                  zip(self.axis_names, origin, self.tile_shape, self.shape))
+                self.fail(f"tile {tile} ({spans}) is recorded done in /progress/tile_done, but its data in "
+                          "/wall_bounces and /outcome no longer match /progress/tile_checksum: the file is damaged")
+            self._verified[tile] = True
+
+    # --- what the file says ----------------------------------------------------------------
 
     def close(self):
         self.file.close()
@@ -238,41 +818,21 @@ class Result:
         return self.counts.shape
 
     @property
-    def coordinates(self):
-        """'canonical' or 'physical' (attribute coordinates; inferred from axis names if absent)."""
-        value = self.attrs.get("coordinates")
-        if value in COORDINATE_NAMES:
-            return value
-        physical = any(n in COORDINATE_NAMES["physical"] for n in self.axis_names)
-        return "physical" if physical else "canonical"
-
-    @property
-    def max_bounces(self):
-        return self.attrs.get("max_bounces")
-
-    @property
     def complete(self):
-        """True/False from attribute complete, None when the file does not say."""
-        value = self.attrs.get("complete")
-        return None if value is None else bool(value)
+        """True for a result, False for the partial file of a run not finished."""
+        return self.kind == KIND_RESULT
 
     def model(self):
-        """Model coefficients (and g, radius for physical grids) present in the file, in display order."""
-        return {key: self.attrs[key] for key in MODEL_ATTRIBUTES if key in self.attrs}
+        """Model coefficients (a number, or "axis:<name>" when swept) and g, radius for physical grids, in display order."""
+        return dict(self._model)
 
     def fixed(self):
-        """Fixed coordinates {name: value} from attributes fixed_<name>, in coordinate order."""
-        fixed = {key[len("fixed_"):]: value for key, value in self.attrs.items() if key.startswith("fixed_")}
-        order = COORDINATE_NAMES[self.coordinates]
-        return dict(sorted(fixed.items(), key=lambda item: order.index(item[0]) if item[0] in order else len(order)))
+        """Fixed coordinates {name: value}, in coordinate order."""
+        return dict(self._fixed)
 
     def tiles(self):
-        """(tiles done, tiles) from /progress/tile_done, or None if the file has no progress record."""
-        dataset = self.file.get("progress/tile_done")
-        if not isinstance(dataset, h5py.Dataset):
-            return None
-        done = dataset[()]
-        return int(np.count_nonzero(done)), int(done.size)
+        """(tiles done, tiles) of a partial file, None for a result (complete: it has no journal)."""
+        return (self.tiles_done, self.tile_count) if self.kind == KIND_PARTIAL else None
 
     def model_text(self):
         """One line with every coefficient and max_bounces, for titles."""
@@ -283,19 +843,46 @@ class Result:
         return join_values(self.fixed())
 
 
-def axis_label(name):
-    """Axis label with the SPEC name and its definition or unit."""
-    return AXIS_LABELS.get(name, name)
+def index_text(index):
+    """An index tuple as text: [3, 0:10, :]."""
+    def one(i):
+        if not isinstance(i, slice):
+            return str(i)
+        text = f"{'' if i.start is None else i.start}:{'' if i.stop is None else i.stop}"
+        return text + (f":{i.step}" if i.step not in (None, 1) else "")
+    return "[" + ", ".join(one(i) for i in index) + "]"
+
+
+def tile_checksum(counts, outcomes, tile, origin):
+    """The checksum a partial file records for a tile (src/io/partial_file.hpp): XXH3-64 of
+    the tile's chunk of /wall_bounces as stored, seeded with the tile's number, then of its
+    chunk of /outcome seeded with that.  None when python3-xxhash is not installed."""
+    try:
+        import xxhash  # Debian's python3-xxhash
+    except ImportError:
+        return None
+    try:
+        stored_counts = counts.id.read_direct_chunk(origin)[1]
+        stored_outcomes = outcomes.id.read_direct_chunk(origin)[1]
+    except H5PY_ERRORS:
+        return -1  # a chunk that cannot be read matches no checksum
+    return xxhash.xxh3_64_intdigest(stored_outcomes, seed=xxhash.xxh3_64_intdigest(stored_counts, seed=tile))
 
 
 def warn_if_incomplete(result):
-    """Warn that a run did not finish: unfinished tiles hold zeros (outcome invalid)."""
-    if result.complete is False:
-        tiles = result.tiles()
-        detail = f" ({tiles[0]} of {tiles[1]} tiles done)" if tiles else ""
-        warn(f"{result.path} is incomplete{detail}: unfinished points show as invalid")
+    """Warn that a file is the partial file of a run not finished (its points not computed
+    read as invalid). Scripts call it once the data are read, so that a damaged file gets
+    one message, the error, and nothing before it."""
+    if not result.complete:
+        warn(f"{result.path} is the partial file of an incomplete run ({result.tiles_done} of {result.tile_count} "
+             "tiles done): the points of the tiles not done read as invalid")
         return True
     return False
+
+
+def axis_label(name):
+    """Axis label with the SPEC name and its definition or unit."""
+    return AXIS_LABELS.get(name, name)
 
 
 def cell_edges(samples):

@@ -11,8 +11,6 @@ import csv
 import io
 import math
 import os
-import shutil
-import subprocess
 import sys
 from typing import NamedTuple
 
@@ -21,13 +19,13 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from superball_results import (  # noqa: E402  (needs the path above)
-    EXIT_FAILURE,
     ScriptError,
     format_number,
     new_figure,
     parse_size,
     pyplot,
     run_script,
+    run_superball,
 )
 
 COLUMNS = ("event", "wall_bounces", "t", "x", "y", "u_in", "v_in", "omega_in", "u", "v", "omega")
@@ -188,27 +186,17 @@ def read_csv(text, source):
     return Trajectory(events, path if len(path) else None, source)
 
 
-def run_superball(arguments):
+def run_trajectory(arguments):
     """CSV text of `superball trajectory ARGS`, with flight samples for a smooth path."""
-    binary = os.environ.get("SUPERBALL") or shutil.which("superball")
-    if not binary:
-        raise ScriptError("cannot find the superball binary: set SUPERBALL or put superball on PATH", EXIT_FAILURE)
-    if arguments and arguments[0] == "trajectory":
-        arguments = arguments[1:]
     if not any(arg == "--samples" or arg.startswith("--samples=") for arg in arguments):
         arguments = arguments + ["--samples", str(RUN_SAMPLES)]
-    command = [binary, "trajectory"] + arguments
-    process = subprocess.run(command, capture_output=True, text=True)
-    if process.returncode != 0:
-        status = process.returncode if process.returncode in (1, 2) else EXIT_FAILURE
-        raise ScriptError(f"{' '.join(command)} failed: {process.stderr.strip()}", status)
-    return process.stdout
+    return run_superball("trajectory", arguments)
 
 
 def load(args):
     """The trajectory and a name for it (for titles and the default output)."""
     if args.run is not None:
-        return read_csv(run_superball(args.run), "superball trajectory"), None
+        return read_csv(run_trajectory(args.run), "superball trajectory"), None
     if args.input == "-":
         return read_csv(sys.stdin.read(), "standard input"), None
     if not os.path.isfile(args.input):

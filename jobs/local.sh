@@ -5,12 +5,14 @@
 #   jobs/local.sh JOB.toml [superball explore options...]     e.g. --overwrite, --resume
 #
 # Environment: SUPERBALL_RANKS (default: number of cores), SUPERBALL_BUILD (build
-# directory, default build/native: optimised for this host's instruction set).
+# directory, default build/native: optimised for this host's instruction set). On one
+# node superball asks Open MPI for its shared-memory layer (ob1) itself, unless
+# OMPI_MCA_pml is set (README: Start-up on one node).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(dirname "$here")
 if [[ $# -lt 1 || "$1" == -h || "$1" == --help ]]; then
-  sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,10p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
   exit $(( $# < 1 ? 2 : 0 ))
 fi
 job=$1; shift

@@ -49,8 +49,10 @@ def descendants(pid):
 
 def capped_job(max_bounces, n_xi=2, n_W=2, tile_points=None):
     """A job in which every point bounces to the cap: around the marginally stable
-    self-retracing motion (0.25, -0.5, -1.25) of the dissipation-free model."""
-    run = f"max_bounces = {max_bounces}" + (f"\ntile_points = {tile_points}" if tile_points else "")
+    self-retracing motion (0.25, -0.5, -1.25) of the dissipation-free model. The resume
+    journal is written every 0.1 s."""
+    run = (f"max_bounces = {max_bounces}" + (f"\ntile_points = {tile_points}" if tile_points else "") +
+           "\ncheckpoint_seconds = 0.1")
     return ("[model]\ne = 1.0\nalpha = 1.0\n\n[grid]\n"
             f"xi = {{ min = 0.24, max = 0.26, n = {n_xi} }}\nU = -0.5\nW = {{ min = -1.27, max = -1.23, n = {n_W} }}\n\n"
             f"[run]\n{run}\n")
@@ -60,27 +62,107 @@ def killable_job(speed, seconds):
     """No dissipation over the (xi, W) slice at U = -1: about 11000 of its 300^2 points
     bounce to the cap, max_bounces set from `speed` (wall_impacts_per_second) so that two
     ranks take about `seconds`, in tiles of 400 points that each take a fraction of a
-    second (a clean stop is quick)."""
+    second (a clean stop is quick); the resume journal is written every 0.1 s, so a kill
+    part-way leaves tiles recorded done."""
     max_bounces = max(100, int(2 * seconds * speed / 11000))
     return ("[model]\ne = 1.0\nalpha = 1.0\n\n[grid]\n"
             "xi = { min = 0.0, max = 1.0, n = 300 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 300 }\n\n"
-            f"[run]\nmax_bounces = {max_bounces}\ntile_points = 400\n")
+            f"[run]\nmax_bounces = {max_bounces}\ntile_points = 400\ncheckpoint_seconds = 0.1\n")
 
 
 def wall_impacts_per_second(binary, directory):
     """Wall impacts per second of one rank of `binary`, from the summary of a run in which
     every point is capped (max_bounces raised until it takes a quarter of a second). Tests
     that must stop a run part-way size their jobs with it, so that the runs last the same
-    few seconds in a release build and under AddressSanitizer."""
+    few seconds in a release build and under AddressSanitizer. 64 points: enough to fill
+    the widest vector kernel (8 lanes) as the jobs it sizes do; with fewer the kernel is
+    limited by the latency of one batch, and a job sized by it ends twice too early."""
     job, out = os.path.join(directory, "calibrate.toml"), os.path.join(directory, "calibrate.h5")
-    max_bounces = 100000
+    max_bounces = 25000
     while True:
         with open(job, "w") as f:
-            f.write(capped_job(max_bounces))
+            f.write(capped_job(max_bounces, n_xi=8, n_W=8))
         r = subprocess.run([binary, "explore", job, "-o", out, "--overwrite"], capture_output=True, text=True,
                            env=mpi_env(), timeout=300)
         assert r.returncode == 0, r.stderr
-        seconds = float(r.stderr.split("done: 4 points computed in ")[1].split()[0])
+        seconds = float(r.stderr.split("done: 64 points computed in ")[1].split()[0])
         if seconds >= 0.25 or max_bounces >= 10**9:
-            return 4 * max_bounces / max(seconds, 0.01)
+            return 64 * max_bounces / max(seconds, 0.01)
         max_bounces *= 4
+
+
+def tile_boxes(shape, tile_shape):
+    """The boxes (tuples of slices) of the tiles of a grid, in tile order (row-major)."""
+    import itertools
+    per_axis = [range(0, n, t) for n, t in zip(shape, tile_shape)]
+    return [tuple(slice(s, min(s + t, n)) for s, t, n in zip(start, tile_shape, shape))
+            for start in itertools.product(*per_axis)]
+
+
+def tile_checksum(dataset_counts, dataset_outcomes, tile, origin):
+    """The checksum the partial file records for a tile, computed independently of
+    superball: XXH3-64 of the tile's chunk of /wall_bounces, as stored, seeded with the tile's
+    number, then of its chunk of /outcome seeded with that."""
+    import xxhash  # Debian's python3-xxhash
+    counts = dataset_counts.id.read_direct_chunk(origin)[1]
+    outcomes = dataset_outcomes.id.read_direct_chunk(origin)[1]
+    return xxhash.xxh3_64_intdigest(outcomes, seed=xxhash.xxh3_64_intdigest(counts, seed=tile))
+
+
+def interrupted_run(binary, job, out, reference, done):
+    """The partial file (OUT.partial) of an interrupted run of `job`: a run stopped before its
+    first tile (--stop-after 0), then the tiles t with done(t) filled with `reference`'s
+    values and recorded done with their checksums, as the run would have. Returns its path."""
+    import h5py
+    r = subprocess.run([binary, "explore", job, "-o", out, "-q", "--stop-after", "0"], capture_output=True, text=True,
+                       env=mpi_env(), timeout=300)
+    assert r.returncode == 1, r.stderr
+    partial = out + ".partial"
+    with h5py.File(reference, "r") as ref, h5py.File(partial, "r+") as f:
+        counts, outcomes = f["wall_bounces"], f["outcome"]
+        flags, sums = f["progress/tile_done"][()], f["progress/tile_checksum"][()]
+        for t, box in enumerate(tile_boxes(counts.shape, [int(n) for n in f.attrs["tile_shape"]])):
+            if not done(t):
+                continue
+            counts[box] = ref["wall_bounces"][box]
+            outcomes[box] = ref["outcome"][box]
+            sums[t] = tile_checksum(counts, outcomes, t, tuple(s.start for s in box))
+            flags[t] = 1
+        f["progress/tile_checksum"][...] = sums
+        f["progress/tile_done"][...] = flags
+    return partial
+
+
+# Small jobs of every kind of result the outside clients (xarray, netCDF tools, ParaView)
+# must read: grids of a few thousand points, each run in well under a second. The axes
+# have different lengths, so that a transposed reading cannot pass.
+CLIENT_JOBS = {
+    "slice": ("[model]\ne = 0.9\nalpha = 0.9\n\n[grid]\n"
+              "xi = { min = 0.0, max = 1.0, n = 40 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 30 }\n"),
+    "volume": ("[model]\ne = 0.9\nalpha = 0.9\n\n[grid]\n"
+               "xi = { min = 0.0, max = 1.0, n = 20 }\nU = { min = -3.0, max = -0.2, n = 12 }\n"
+               "W = { min = -3.0, max = 3.0, n = 16 }\n"),
+    "physical": ("[model]\ne = 0.9\nalpha = 0.9\ng = 9.81\nradius = 0.025\n\n[grid]\ncoordinates = \"physical\"\n"
+                 "x = { min = 0.0, max = 0.2, n = 30 }\nu = { min = -3.0, max = 1.0, n = 20 }\nv = 2.0\nomega = -200.0\n"),
+    "swept": ("[model]\ne = 0.9\nalpha = { min = 0.5, max = 1.0, n = 5 }\ne_floor = 0.8\n\n[grid]\n"
+              "xi = { min = 0.0, max = 1.0, n = 40 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 30 }\n"),
+}
+
+
+def client_results(directory, kinds, names=None):
+    """Results of CLIENT_JOBS[kind] for each of `kinds`, computed by the binary under test
+    with two ranks in `directory`; `names` maps a kind to its output's file name (default
+    KIND.h5). Returns {kind: absolute path of the result}."""
+    binary = superball_binary()
+    mpiexec = os.environ.get("MPIEXEC") or "mpirun"
+    paths = {}
+    for kind in kinds:
+        name = (names or {}).get(kind, kind + ".h5")
+        job, out = os.path.join(directory, kind + ".toml"), os.path.abspath(os.path.join(directory, name))
+        with open(job, "w") as f:
+            f.write(CLIENT_JOBS[kind] + "\n[run]\nmax_bounces = 1000\n")
+        cmd = [mpiexec, "-n", "2", "--oversubscribe", binary, "explore", job, "-o", out, "-q"]
+        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=300)
+        assert r.returncode == 0, f"{' '.join(cmd)}\n{r.stderr}"
+        paths[kind] = out
+    return paths

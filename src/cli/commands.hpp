@@ -16,5 +16,6 @@ Runner add_explore_command(CLI::App& app);
 Runner add_info_command(CLI::App& app);
 Runner add_analyse_command(CLI::App& app);
 Runner add_fixed_points_command(CLI::App& app);
+Runner add_continue_command(CLI::App& app);
 
 }  // namespace superball::cli

@@ -2,13 +2,16 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 
 #include "commands.hpp"
 #include "core/count.hpp"
+#include "core/kernels.hpp"
 #include "io/hdf5.hpp"
-#include "io/result_file.hpp"
+#include "io/layout.hpp"
+#include "io/result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
 #include "mpi/mpi.hpp"
@@ -29,10 +32,11 @@ struct ExploreOptions {
     bool overwrite = false;
     bool quiet = false;
     bool dry_run = false;
-    std::string kernel = "simd";
+    double stop_after = -1;  // seconds of computing, then a clean stop; < 0: none
+    std::string kernel;  // empty: $SUPERBALL_KERNEL, else the best variant
 };
 
-void print_summary(const Job& job, const RunSummary& r)
+void print_summary(const Job& job, const RunSummary& r, const KernelVariant& kernel)
 {
     const double s = r.compute_seconds;
     const auto n = r.points_this_run;
@@ -46,15 +50,25 @@ void print_summary(const Job& job, const RunSummary& r)
     }
     fmt::print(stderr, "{}\n", line);
     fmt::print(stderr, "peak memory per rank: {:.1f} MiB (largest rank)\n", r.peak_rss_mib);
-    fmt::print(stderr, "result: {}\n", r.output.string());
+    fmt::print(stderr, "counting kernel: {}\n", describe(kernel));
+    if (r.complete && r.raw_bytes > 0) {
+        fmt::print(stderr, "result: {} ({:.3g} MB, {:.2f}% of the {:.3g} MB of raw data; written in {:.2f} s)\n",
+                   r.output.string(), static_cast<double>(r.result_bytes) / 1e6,
+                   100.0 * static_cast<double>(r.result_bytes) / static_cast<double>(r.raw_bytes),
+                   static_cast<double>(r.raw_bytes) / 1e6, r.finish_seconds);
+    } else if (r.complete) {
+        fmt::print(stderr, "result: {}\n", r.output.string());
+    }
+    if (!r.sidecar_note.empty()) fmt::print(stderr, "{}\n", r.sidecar_note);
     if (job.refine != 0) {
         fmt::print(stderr, "refinement: {} of {} points counted ({:.1f}%), the others filled from agreeing corners\n",
                    r.points_counted, n, 100.0 * static_cast<double>(r.points_counted) / static_cast<double>(std::max<std::uint64_t>(n, 1)));
     }
     if (r.interrupted) {
-        fmt::print(stderr, "stopped by a signal: {} is consistent and incomplete; run the same command with "
-                           "--resume to finish it\n",
-                   r.output.string());
+        fmt::print(stderr, "stopped {}: the run is kept in {} (consistent, {} not written yet); run the same command "
+                           "with --resume to finish it\n",
+                   StopSignals::which() != 0 ? "by a signal" : "after --stop-after seconds",
+                   layout::partial_path(r.output).string(), r.output.string());
     }
 }
 
@@ -80,15 +94,21 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
     const Tiling tiling = default_tiling(job, ranks);
     fmt::print("tiles: {} of up to {} points for {} rank{}\n", tiling.tiles(), tiling.box(0).points(), ranks,
                ranks == 1 ? "" : "s");
+    // For batch scripts deciding between a new run and --resume: the result, or the partial
+    // file of an interrupted run.
     std::error_code ec;
-    const bool exists = fs::exists(out, ec);
+    const fs::path partial = layout::partial_path(out);
+    const bool has_partial = fs::exists(partial, ec);
+    const bool exists = has_partial || fs::exists(out, ec);
     fmt::print("output: {}\noutput exists: {}\n", out.string(), exists ? "yes" : "no");
     if (!exists) return;
-    // For batch scripts deciding between a new run and --resume.
+    fmt::print("partial file: {}\n", has_partial ? partial.string() : "none");
     try {
-        const ResultInfo info = read_result_info(out);
-        fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n", info.complete ? "yes" : "no",
-                   info.tiles_done, info.tiles, info.job_fingerprint == fingerprint(job) ? "yes" : "no");
+        const ResultReader reader(has_partial ? partial : out);
+        const ResultInfo& info = reader.info();
+        fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n",
+                   info.kind == FileKind::result ? "yes" : "no", info.tiles_done, info.tiles,
+                   info.job_fingerprint == fingerprint(job) ? "yes" : "no");
     } catch (const std::exception&) {
         fmt::print("output complete: unreadable (not a superball result)\n");
     }
@@ -103,22 +123,32 @@ int explore(const ExploreOptions& opt)
     const bool root = world.is_root();
     h5::silence_errors();
     try {
+        const KernelVariant& kernel = select_kernel(opt.kernel);
         const Job job = load_job(opt.job);
-        const ExploreSettings settings{opt.output, opt.resume, opt.overwrite,
-                                       opt.kernel == "scalar" ? KernelChoice::scalar : KernelChoice::simd};
+        const ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
         const fs::path out = output_path(job, settings);
         if (opt.dry_run) {
             if (root) print_plan(job, out, world.size());
             return 0;
         }
         TerminalProgress progress(stderr, opt.quiet);
-        const RunSummary r = run_explore(job, settings, world, progress, &StopSignals::requested);
-        if (root && !r.nothing_to_do) print_summary(job, r);
+        const auto started = std::chrono::steady_clock::now();
+        const StopRequested stop = [&] {
+            return StopSignals::requested() ||
+                   (opt.stop_after >= 0 &&
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() >= opt.stop_after);
+        };
+        const RunSummary r = run_explore(job, settings, world, progress, stop);
+        if (root && !r.nothing_to_do) print_summary(job, r, kernel);
         return r.interrupted ? 1 : 0;
     } catch (const InputError& e) {
         // Every rank reads the same job and gets the same verdict: one message is enough.
         if (root) fmt::print(stderr, "superball explore: {}\n", e.what());
         return 2;
+    } catch (const RunError& e) {
+        // Every rank failed alike, in step: one message, and a clean exit.
+        if (root) fmt::print(stderr, "superball explore: error: {}\n", e.what());
+        return 1;
     } catch (const std::exception& e) {
         // Past the job's validation the ranks may no longer be in step: end them all.
         fmt::print(stderr, "superball explore (rank {}): error: {}\n", world.rank(), e.what());
@@ -132,10 +162,12 @@ Runner add_explore_command(CLI::App& app)
 {
     auto* sub = app.add_subcommand("explore", "Count wall bounces over a grid of starts (run under mpirun)");
     sub->footer(
-        "Run as `mpirun -n P superball explore JOB.toml` (P >= 1; every rank computes). The result is one HDF5\n"
-        "file (SPEC.md section 5) plus a .xmf sidecar for ParaView. An existing result is never overwritten\n"
-        "unless --overwrite is given; --resume finishes an interrupted run of the same job (a different job\n"
-        "is refused). SIGINT/SIGTERM (or SIGUSR1/2, which mpirun forwards to every rank) stop cleanly\n"
+        "Run as `mpirun -n P superball explore JOB.toml` (P >= 1). The result is one HDF5 file in\n"
+        "netCDF-4/CF layout (xarray, ncdump, h5py read it), compressed, plus a .xmf sidecar for ParaView.\n"
+        "While the run goes on, its tiles are in OUTPUT.partial; the result takes its name only once\n"
+        "complete. An existing result is never overwritten unless --overwrite is given, and only a\n"
+        "superball file is ever replaced; --resume finishes an interrupted run of the same job (a different\n"
+        "job is refused). SIGINT/SIGTERM (or SIGUSR1/2, which mpirun forwards to every rank) stop cleanly\n"
         "(resumable); a second signal stops at once (still resumable).");
     auto opt = std::make_shared<ExploreOptions>();
     sub->add_option("job", opt->job, "TOML job file (SPEC.md section 4)")->required();
@@ -144,9 +176,16 @@ Runner add_explore_command(CLI::App& app)
     auto* overwrite = sub->add_flag("--overwrite", opt->overwrite, "replace an existing output file");
     sub->get_option("--resume")->excludes(overwrite);
     sub->add_flag("-q,--quiet", opt->quiet, "no progress lines");
-    sub->add_option("--kernel", opt->kernel, "counting kernel: simd (vectorised) or scalar; identical results")
-        ->check(CLI::IsMember({"simd", "scalar"}))
-        ->capture_default_str();
+    sub->add_option("--stop-after", opt->stop_after,
+                    "stop cleanly after this many seconds, as on SIGTERM (resumable with --resume): a time budget for "
+                    "batch jobs")
+        ->check(CLI::NonNegativeNumber);
+    std::string variants;
+    for (const KernelVariant& k : simd_kernels()) variants += (variants.empty() ? "" : ", ") + std::string(k.name);
+    sub->add_option("--kernel", opt->kernel,
+                    "counting kernel, identical results: simd (the widest variant this processor runs, here " +
+                        describe(best_kernel()) + "), scalar, or a variant of this build (" + variants +
+                        "); default: $SUPERBALL_KERNEL, else simd");
     sub->add_flag("--dry-run", opt->dry_run, "check the job and print the plan (grid, tiles, output) without running");
     return [opt] { return explore(*opt); };
 }

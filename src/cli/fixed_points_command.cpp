@@ -123,19 +123,13 @@ int run(const FixedPointOptions& opt)
     }
     if (!world.is_root()) return 0;
 
-    std::FILE* f = stdout;
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
-    if (!opt.output.empty()) {
-        file.reset(std::fopen(opt.output.c_str(), "w"));
-        if (!file) throw std::runtime_error("cannot write " + opt.output);
-        f = file.get();
-    }
-    if (opt.format == "json") {
-        write_json(f, cycles, model, opt, world.size());
-    } else {
-        write_table(f, cycles, model, opt, world.size());
-    }
-    if (file && std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + opt.output);
+    write_output(opt.output, [&](std::FILE* f) {
+        if (opt.format == "json") {
+            write_json(f, cycles, model, opt, world.size());
+        } else {
+            write_table(f, cycles, model, opt, world.size());
+        }
+    });
     return 0;
 }
 

@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "core/input.hpp"
+#include "core/kernels.hpp"
 #include "job/spelling.hpp"
 #include "superball/version.hpp"
 
@@ -65,14 +66,17 @@ int main(int argc, char** argv)
     CLI::App app{"superball: how many times a spinning superball bounces between a floor and a wall\n"
                  "(Cross impact model) before it escapes, for one start or a whole grid of starts.",
                  "superball"};
-    app.set_version_flag("--version", std::string("superball ") + software_version);
+    // The kernel line names the instruction set a run here would count with (SUPERBALL_KERNEL
+    // included), for bug reports and for checking a node's binary.
+    app.set_version_flag("--version", [] { return std::string("superball ") + software_version + "\n" + kernel_report(); });
     app.require_subcommand(1);
     app.footer("Run `superball COMMAND --help` for the options of a command. Exit status: 0 success,\n"
                "2 bad input (the message names it), 1 other failure.");
 
     std::map<const CLI::App*, cli::Runner> runners;
     for (auto add : {cli::add_explore_command, cli::add_count_command, cli::add_trajectory_command,
-                     cli::add_info_command, cli::add_analyse_command, cli::add_fixed_points_command}) {
+                     cli::add_info_command, cli::add_analyse_command, cli::add_fixed_points_command,
+                     cli::add_continue_command}) {
         auto run = add(app);
         runners.emplace(app.get_subcommands({}).back(), std::move(run));
     }

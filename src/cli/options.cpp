@@ -1,6 +1,8 @@
 #include "options.hpp"
 
 #include <cmath>
+#include <memory>
+#include <stdexcept>
 
 namespace superball::cli {
 
@@ -45,6 +47,18 @@ void add_max_bounces_flag(CLI::App& app, std::uint32_t& max_bounces)
     app.add_option("--max-bounces", max_bounces, "stop after this many wall impacts (outcome capped)")
         ->check(CLI::Range(std::uint32_t{1}, std::uint32_t{4294967295u}))
         ->capture_default_str();
+}
+
+void write_output(const std::string& path, const std::function<void(std::FILE*)>& write)
+{
+    if (path.empty()) {
+        write(stdout);
+        return;
+    }
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "w"), &std::fclose);
+    if (!file) throw std::runtime_error("cannot write " + path);
+    write(file.get());
+    if (std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + path);
 }
 
 namespace {

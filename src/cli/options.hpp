@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <cstdio>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -37,5 +39,9 @@ struct Start {
 Start resolve_start(const StartFlags& in);
 
 void add_max_bounces_flag(CLI::App& app, std::uint32_t& max_bounces);
+
+// Runs write(f) on standard output, or on the file `path` when it is not empty (-o); throws
+// std::runtime_error("cannot write PATH") when the file cannot be opened or closed.
+void write_output(const std::string& path, const std::function<void(std::FILE*)>& write);
 
 }  // namespace superball::cli

@@ -89,18 +89,13 @@ Runner add_trajectory_command(CLI::App& app)
         const Start start = resolve_start(opt->start);
         if (opt->samples == 1) throw InputError("--samples = 1 is out of range: accepted 0 or 2..100000");
         const Trajectory tr = trajectory(start.state, model, start.frame.g, opt->max_bounces, opt->samples);
-        std::FILE* f = stdout;
-        std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
-        if (!opt->output.empty()) {
-            file.reset(std::fopen(opt->output.c_str(), "w"));
-            if (!file) throw std::runtime_error("cannot write " + opt->output);
-            f = file.get();
-        }
-        if (opt->format == "json") {
-            write_json(f, tr, start, model);
-        } else {
-            write_csv(f, tr, start.frame.radius);
-        }
+        write_output(opt->output, [&](std::FILE* f) {
+            if (opt->format == "json") {
+                write_json(f, tr, start, model);
+            } else {
+                write_csv(f, tr, start.frame.radius);
+            }
+        });
         if (tr.truncated) {
             fmt::print(stderr,
                        "superball trajectory: events stop after wall impact {}: the motion converges into the corner "

@@ -1,24 +1,64 @@
-#include "count_simd.hpp"
-
-#include <algorithm>
-#include <array>
+// One variant of the vectorised counting kernel: several start points advanced together
+// through G.
+//
+// SIMD through std::experimental::simd (libstdc++'s Parallelism TS 2, shipped with the
+// compiler: no extra dependency): its native type maps to SSE2, AVX2 or AVX-512 registers
+// according to the instruction set this file is compiled for, and the map is the same
+// template canonical_map<T> as the scalar count(), instantiated on a SIMD batch. With
+// -ffp-contract=off (set for the whole project) every lane performs exactly the scalar
+// operations in the same order, and IEEE division and square root are correctly rounded
+// in both, so every variant agrees with the scalar kernel bit for bit; tests/core checks
+// it on the reference points and grids.
+//
+// This file is compiled once per variant (src/CMakeLists.txt: the baseline, AVX2+FMA and
+// AVX-512 in a portable x86-64 build; one variant elsewhere), each time with
+// SUPERBALL_SIMD_NAMESPACE naming the namespace of its entry points. kernels.cpp picks the
+// variant the processor runs. Nothing here may be an inline function or template that
+// other code also instantiates (std::span, std::array, std::min...): the linker keeps one
+// copy of such a symbol for the whole program, and the AVX-512 copy would run on a
+// processor without AVX-512. Only the map templates on this variant's own SIMD type, whose
+// names no other variant shares, are left (check_kernel_isolation.cmake).
+// First, so that the pragmas cover the compiler's intrinsics headers it brings in: GCC 12's
+// avx512fintrin.h makes an "undefined" register with `__m512d __Y = __Y;`
+// (_mm512_undefined_pd, used by _mm512_sqrt_pd), and once inlined into the AVX-512
+// variant that self-initialisation is reported as a use of an uninitialised value (GCC 13
+// no longer does). Only these headers are exempt; this file's own code is still checked.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#ifndef __clang__  // GCC's name: clang would warn about an unknown option
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <experimental/simd>
+#pragma GCC diagnostic pop
+
 #include <limits>
 
-namespace superball {
+#include "count.hpp"
+#include "count_simd_variant.hpp"
+
+#ifndef SUPERBALL_SIMD_NAMESPACE
+#error "compile with -DSUPERBALL_SIMD_NAMESPACE=simd_<variant> (src/CMakeLists.txt)"
+#endif
+
+SUPERBALL_DECLARE_SIMD_VARIANT(SUPERBALL_SIMD_NAMESPACE)
+
+namespace superball::SUPERBALL_SIMD_NAMESPACE {
 
 namespace {
 
 namespace stdx = std::experimental;
-// One register of the build's widest vector unit: 2 lanes with SSE2 (the portable
-// build), 4 with AVX2. (fixed_size_simd<double, 8> was measured 3.7x slower per lane
-// with GCC 12: its generic implementation does not keep the lanes in registers.)
+// One register of the widest vector unit this file is compiled for: 2 lanes with SSE2
+// (the x86-64 baseline), 4 with AVX2, 8 with AVX-512. (fixed_size_simd<double, 8> was
+// measured 3.7x slower per lane with GCC 12: its generic implementation does not keep the
+// lanes in registers.)
 using Batch = stdx::native_simd<double>;
 constexpr std::size_t width = Batch::size();
 
 // Points are taken a block at a time; the block's live points are kept packed at the
-// front of structure-of-arrays buffers.
+// front of structure-of-arrays buffers, padded by one batch so the last, partial batch can
+// be loaded and stored whole.
 constexpr std::size_t block = 512;
+constexpr std::size_t padded = block + width;
 
 // Exit codes as doubles, so that they are computed with vector selects: an Outcome, or
 // go_on for a point that needs another excursion.
@@ -26,28 +66,28 @@ constexpr double go_on = -1.0;
 constexpr double code(Outcome o) { return static_cast<double>(o); }
 
 struct Live {
-    // Padded by one batch so the last, partial batch can be loaded and stored whole.
-    alignas(64) std::array<double, block + width> xi, U, W, n;
-    std::array<std::size_t, block + width> point;
-    std::size_t size = 0;
+    alignas(64) double xi[padded];
+    alignas(64) double U[padded];
+    alignas(64) double W[padded];
+    alignas(64) double n[padded];
+    std::size_t point[padded];
+    std::size_t size;
 };
 
 // What one application of G made of a batch of points: the new state, the new count and
 // the exit code.
 struct Stepped {
-    alignas(64) std::array<double, block + width> xi, U, W, n, code;
-};
-
-// Where the results of the points go.
-struct Results {
-    std::span<std::uint32_t> wall_bounces;
-    std::span<std::uint8_t> outcomes;
+    alignas(64) double xi[padded];
+    alignas(64) double U[padded];
+    alignas(64) double W[padded];
+    alignas(64) double n[padded];
+    alignas(64) double code[padded];
 };
 
 // G applied to a batch: the exits of SPEC.md section 3 after the step, in the order
 // count() checks them (invalid takes precedence over left over missed over capped).
-[[gnu::always_inline]] inline void step(const CanonicalState<Batch>& c, const Batch& count, const ModelMatrices& m, double max_bounces,
-          Stepped& next, std::size_t i)
+[[gnu::always_inline]] inline void step(const CanonicalState<Batch>& c, const Batch& count, const ModelMatrices& m,
+                                        double max_bounces, Stepped& next, std::size_t i)
 {
     const CanonicalStep<Batch> s = canonical_map(c, m);
     Batch exit = go_on;
@@ -72,12 +112,12 @@ struct Results {
 // of live points, however long some of them live. Neighbouring points of a grid mostly
 // end alike, so the branch is well predicted (measured faster than storing every point
 // every step without a branch).
-void settle(const Stepped& next, std::size_t n, const std::size_t* point, Live& live, const Results& out)
+void settle(const Stepped& next, std::size_t n, const std::size_t* point, Live& live, const simd_variant::Arrays& out)
 {
     // Locals, not members: a store through the uint8_t outcomes may alias anything, and
     // would make the compiler reload every pointer and the size after it.
-    std::uint32_t* const wall_bounces = out.wall_bounces.data();
-    std::uint8_t* const outcomes = out.outcomes.data();
+    std::uint32_t* const wall_bounces = out.wall_bounces;
+    std::uint8_t* const outcomes = out.outcomes;
     std::size_t size = live.size;
     for (std::size_t i = 0; i < n; ++i) {
         const std::size_t p = point[i];
@@ -96,25 +136,35 @@ void settle(const Stepped& next, std::size_t n, const std::size_t* point, Live& 
     live.size = size;
 }
 
-// The first excursion of a block, read straight from the input: the checks count()
-// makes before any excursion (not a launch, missing at once) are vector compares too.
-// Two passes, the arithmetic alone over all batches and then the bookkeeping point by
-// point: kept apart, each loop is short enough for the processor to overlap many
-// batches; interleaved, every batch waited on its own divisions and square root.
-void first_sweep(const StartsView& in, const ModelMatrices& m, double max_bounces, Stepped& next, Live& live,
-                 std::array<std::size_t, block + width>& index, const Results& out, std::size_t first)
+// The first excursion of the n points from `first` on, read straight from the input: the
+// checks count() makes before any excursion (not a launch, missing at once) are vector
+// compares too. Two passes, the arithmetic alone over all batches and then the
+// bookkeeping point by point: kept apart, each loop is short enough for the processor to
+// overlap many batches; interleaved, every batch waited on its own divisions and square
+// root.
+void first_sweep(const simd_variant::Arrays& in, std::size_t first, std::size_t n, const ModelMatrices& m,
+                 double max_bounces, Stepped& next, Live& live, std::size_t* index)
 {
-    const std::size_t n = in.size();
+    const double* const xi = in.xi + first;
+    const double* const U = in.U + first;
+    const double* const W = in.W + first;
     for (std::size_t i = 0; i < n; i += width) {
-        // The last batch may be partial: its missing lanes get a harmless launch.
-        auto lane = [&](std::span<const double> x, double pad) {
-            return Batch([&](auto l) { return i + l < n ? x[i + l] : pad; });
-        };
-        const CanonicalState<Batch> c = i + width <= n
-                                            ? CanonicalState<Batch>{Batch(&in.xi[i], stdx::element_aligned),
-                                                                    Batch(&in.U[i], stdx::element_aligned),
-                                                                    Batch(&in.W[i], stdx::element_aligned)}
-                                            : CanonicalState<Batch>{lane(in.xi, 0.5), lane(in.U, -1.0), lane(in.W, 0.0)};
+        CanonicalState<Batch> c;
+        if (i + width <= n) {
+            c = {Batch(xi + i, stdx::element_aligned), Batch(U + i, stdx::element_aligned),
+                 Batch(W + i, stdx::element_aligned)};
+        } else {
+            // The last batch is partial: its missing lanes get a harmless launch.
+            alignas(64) double part[3][width];
+            for (std::size_t l = 0; l < width; ++l) {
+                const bool inside = i + l < n;
+                part[0][l] = inside ? xi[i + l] : 0.5;
+                part[1][l] = inside ? U[i + l] : -1.0;
+                part[2][l] = inside ? W[i + l] : 0.0;
+            }
+            c = {Batch(part[0], stdx::vector_aligned), Batch(part[1], stdx::vector_aligned),
+                 Batch(part[2], stdx::vector_aligned)};
+        }
         step(c, Batch(1.0), m, max_bounces, next, i);
         Batch before = go_on;  // decided before any excursion, with 0 impacts
         stdx::where(!(c.xi < 1.0), before) = code(Outcome::missed);
@@ -131,11 +181,11 @@ void first_sweep(const StartsView& in, const ModelMatrices& m, double max_bounce
     }
     for (std::size_t i = 0; i < n; ++i) index[i] = first + i;
     live.size = 0;
-    settle(next, n, index.data(), live, out);
+    settle(next, n, index, live, in);
 }
 
 // One more excursion for every live point.
-void sweep(Live& live, Stepped& next, const ModelMatrices& m, double max_bounces, const Results& out)
+void sweep(Live& live, Stepped& next, const ModelMatrices& m, double max_bounces, const simd_variant::Arrays& out)
 {
     for (std::size_t i = 0; i < live.size; i += width) {
         const CanonicalState<Batch> c{Batch(&live.xi[i], stdx::vector_aligned), Batch(&live.U[i], stdx::vector_aligned),
@@ -145,35 +195,56 @@ void sweep(Live& live, Stepped& next, const ModelMatrices& m, double max_bounces
     const std::size_t n = live.size;
     live.size = 0;
     // settle() writes live.point[k] for k <= i only after reading point[i]: in place is safe.
-    settle(next, n, live.point.data(), live, out);
+    settle(next, n, live.point, live, out);
 }
 
 }  // namespace
 
-void count_each_simd(const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
-                     std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes)
+void count_each(const simd_variant::Arrays& points, const ModelMatrices& m, std::uint32_t max_bounces)
 {
-    if (max_bounces == 0) {
-        // Every launch is decided before its first excursion: nothing to vectorise.
-        count_each(starts, m, max_bounces, wall_bounces, outcomes);
-        return;
-    }
-    const Results out{wall_bounces, outcomes};
     Live live;
     Stepped next;
-    std::array<std::size_t, block + width> index;
+    std::size_t index[padded];
     // The padding lanes go through the arithmetic unused: give them harmless values.
-    live.xi.fill(0.5);
-    live.U.fill(-1.0);
-    live.W.fill(0.0);
-    live.n.fill(0.0);
-    for (std::size_t first = 0; first < starts.size(); first += block) {
-        const std::size_t n = std::min(block, starts.size() - first);
-        first_sweep(starts.subview(first, n), m, max_bounces, next, live, index, out, first);
-        while (live.size > 0) sweep(live, next, m, max_bounces, out);
+    for (std::size_t i = 0; i < padded; ++i) {
+        live.xi[i] = 0.5;
+        live.U[i] = -1.0;
+        live.W[i] = 0.0;
+        live.n[i] = 0.0;
+    }
+    const auto cap = static_cast<double>(max_bounces);
+    for (std::size_t first = 0; first < points.size; first += block) {
+        const std::size_t n = points.size - first < block ? points.size - first : block;
+        first_sweep(points, first, n, m, cap, next, live, index);
+        while (live.size > 0) sweep(live, next, m, cap, points);
     }
 }
 
-std::size_t simd_lanes() { return width; }
+const char* instruction_set()
+{
+#if defined(__AVX512F__)
+    return "AVX-512";
+#elif defined(__AVX2__) && defined(__FMA__)
+    return "AVX2+FMA";
+#elif defined(__AVX2__)
+    return "AVX2";
+#elif defined(__AVX__)
+    return "AVX";
+#elif defined(__SSE2__)
+    return "SSE2";
+#elif defined(__ARM_FEATURE_SVE)
+    return "SVE";
+#elif defined(__ARM_NEON)
+    return "NEON";
+#elif defined(__VSX__)
+    return "VSX";
+#elif defined(__ALTIVEC__)
+    return "AltiVec";
+#else
+    return "no vector unit known to std::experimental::simd";
+#endif
+}
 
-}  // namespace superball
+std::size_t lanes() { return width; }
+
+}  // namespace superball::SUPERBALL_SIMD_NAMESPACE

@@ -1,7 +1,22 @@
 #include "dynamics.hpp"
 
+// Eigen's solvers, instantiated in this file only. Compiled for AVX-512 (-march=native on
+// such a processor) GCC 12 warns inside them: -Warray-bounds for the 8-double packet
+// stores of SVDBase::_solve_impl into its temporary of at most 3 doubles (on a branch
+// taken only for vectors of 8 or more, which GCC cannot rule out), and
+// -Wmaybe-uninitialized for the `__m256d __Y = __Y;` of the compiler's own
+// _mm256_undefined_pd(), which Eigen's AVX-512 sums (predux) reach in the Householder
+// steps of both solvers (GCC 13 no longer warns). Neither is a defect of this code; the
+// exemption covers the text of these headers, where the warnings arise, so this file's own
+// code is still checked.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Warray-bounds"
+#ifndef __clang__  // GCC's name: clang would warn about an unknown option
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
+#pragma GCC diagnostic pop
 #include <algorithm>
 #include <cmath>
 #include <unsupported/Eigen/AutoDiff>
@@ -50,17 +65,6 @@ double relative_residual(const CanonicalState<double>& s, const ModelMatrices& m
 {
     const auto image = iterate(s, m, k, domain);
     return image ? relative_size(log_residual(s, *image, domain), s) : HUGE_VAL;
-}
-
-// Decreasing modulus; ties (complex pairs) by real part then imaginary part, so the order
-// does not depend on the eigensolver's.
-void sort_eigenvalues(std::array<std::complex<double>, 3>& ev)
-{
-    std::sort(ev.begin(), ev.end(), [](const std::complex<double>& a, const std::complex<double>& b) {
-        if (std::abs(a) != std::abs(b)) return std::abs(a) > std::abs(b);
-        if (a.real() != b.real()) return a.real() > b.real();
-        return a.imag() > b.imag();
-    });
 }
 
 bool lexicographically_less(const CanonicalState<double>& a, const CanonicalState<double>& b)
@@ -113,6 +117,22 @@ std::optional<CanonicalState<double>> iterate(const CanonicalState<double>& s, c
     }
     if (!in_domain(c, domain)) return std::nullopt;
     return c;
+}
+
+std::optional<std::array<std::complex<double>, 3>> sorted_eigenvalues(const Eigen::Matrix3d& a)
+{
+    const Eigen::EigenSolver<Eigen::Matrix3d> solver(a, false);
+    if (solver.info() != Eigen::Success) return std::nullopt;
+    std::array<std::complex<double>, 3> ev;
+    for (int i = 0; i < 3; ++i) ev[static_cast<std::size_t>(i)] = solver.eigenvalues()(i);
+    // Ties (complex pairs) by real part then imaginary part, so the order does not depend on
+    // the eigensolver's.
+    std::sort(ev.begin(), ev.end(), [](const std::complex<double>& x, const std::complex<double>& y) {
+        if (std::abs(x) != std::abs(y)) return std::abs(x) > std::abs(y);
+        if (x.real() != y.real()) return x.real() > y.real();
+        return x.imag() > y.imag();
+    });
+    return ev;
 }
 
 std::string_view name(Stability s)
@@ -227,10 +247,9 @@ std::optional<Cycle> make_cycle(const CanonicalState<double>& point, const Model
     c.residual = relative_size(log_residual(c.points.front(), j.state, domain), c.points.front());
     if (!(c.residual <= residual_tolerance)) return std::nullopt;
     c.lambda = j.lambda;
-    const Eigen::EigenSolver<Eigen::Matrix3d> solver(j.dG, false);
-    if (solver.info() != Eigen::Success) return std::nullopt;
-    for (int i = 0; i < 3; ++i) c.eigenvalues[static_cast<std::size_t>(i)] = solver.eigenvalues()(i);
-    sort_eigenvalues(c.eigenvalues);
+    const auto eigenvalues = sorted_eigenvalues(j.dG);
+    if (!eigenvalues) return std::nullopt;
+    c.eigenvalues = *eigenvalues;
     c.stability = classify(c.eigenvalues);
     c.family = std::any_of(c.eigenvalues.begin(), c.eigenvalues.end(),
                            [](const std::complex<double>& z) { return std::abs(z - 1.0) < family_tolerance; });

@@ -111,6 +111,10 @@ inline constexpr double marginal_tolerance = 1e-9;
 inline constexpr double newton_tolerance = 1e-12;
 inline constexpr double residual_tolerance = 1e-10;
 
+// The eigenvalues of a Jacobian by decreasing modulus (ties: by real part, then imaginary
+// part); nullopt if the eigensolver fails.
+std::optional<std::array<std::complex<double>, 3>> sorted_eigenvalues(const Eigen::Matrix3d& a);
+
 // Stability of a cycle from the eigenvalues of the Jacobian of G^k.
 Stability classify(std::span<const std::complex<double>> eigenvalues);
 

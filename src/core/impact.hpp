@@ -17,31 +17,43 @@ namespace superball {
 
 // The four entries of the tangential impact matrix of one surface, computed once
 // per model: the kernel then does two multiplications and one addition per entry,
-// in the same order in every instantiation.
-struct ImpactMatrix {
-    double e;       // normal restitution
-    double c_ss;    // (5 - 2 alpha)/7: tangential velocity kept
-    double c_sW;    // (2/7)(1 + alpha): spin fed into the tangential velocity
-    double c_Ws;    // (5/7)(1 + alpha): tangential velocity fed into the spin
-    double c_WW;    // (2 - 5 alpha)/7: spin kept
+// in the same order in every instantiation. S is the number type of the coefficients:
+// double everywhere but in continuation (core/continuation.hpp), where a coefficient is
+// the parameter and carries its derivative (automatic differentiation).
+template <class S = double>
+struct BasicImpactMatrix {
+    S e;       // normal restitution
+    S c_ss;    // (5 - 2 alpha)/7: tangential velocity kept
+    S c_sW;    // (2/7)(1 + alpha): spin fed into the tangential velocity
+    S c_Ws;    // (5/7)(1 + alpha): tangential velocity fed into the spin
+    S c_WW;    // (2 - 5 alpha)/7: spin kept
 
-    friend constexpr bool operator==(const ImpactMatrix&, const ImpactMatrix&) = default;
+    friend constexpr bool operator==(const BasicImpactMatrix&, const BasicImpactMatrix&) = default;
 
-    static constexpr ImpactMatrix of(Surface s)
+    static constexpr BasicImpactMatrix of(const S& e, const S& alpha)
     {
-        return {s.e, (5.0 - 2.0 * s.alpha) / 7.0, 2.0 * (1.0 + s.alpha) / 7.0,
-                5.0 * (1.0 + s.alpha) / 7.0, (2.0 - 5.0 * s.alpha) / 7.0};
+        return {e, (5.0 - 2.0 * alpha) / 7.0, 2.0 * (1.0 + alpha) / 7.0, 5.0 * (1.0 + alpha) / 7.0,
+                (2.0 - 5.0 * alpha) / 7.0};
+    }
+    static constexpr BasicImpactMatrix of(Surface s) { return of(S(s.e), S(s.alpha)); }
+};
+
+using ImpactMatrix = BasicImpactMatrix<double>;
+
+template <class S = double>
+struct BasicModelMatrices {
+    BasicImpactMatrix<S> wall;
+    BasicImpactMatrix<S> floor;
+
+    friend constexpr bool operator==(const BasicModelMatrices&, const BasicModelMatrices&) = default;
+
+    static constexpr BasicModelMatrices of(const Model& m)
+    {
+        return {BasicImpactMatrix<S>::of(m.wall), BasicImpactMatrix<S>::of(m.floor)};
     }
 };
 
-struct ModelMatrices {
-    ImpactMatrix wall;
-    ImpactMatrix floor;
-
-    friend constexpr bool operator==(const ModelMatrices&, const ModelMatrices&) = default;
-
-    static constexpr ModelMatrices of(const Model& m) { return {ImpactMatrix::of(m.wall), ImpactMatrix::of(m.floor)}; }
-};
+using ModelMatrices = BasicModelMatrices<double>;
 
 template <class T>
 struct Velocities {
@@ -54,8 +66,8 @@ struct Velocities {
 //   u+ = -e_wall u
 //   v+ = (2/7)(1+alpha_wall) W + (1/7)(5-2 alpha_wall) v_w
 //   W+ = (5/7)(1+alpha_wall) v_w + (1/7)(2-5 alpha_wall) W
-template <class T>
-constexpr Velocities<T> wall_impact(const Velocities<T>& in, const ImpactMatrix& wall)
+template <class T, class S>
+constexpr Velocities<T> wall_impact(const Velocities<T>& in, const BasicImpactMatrix<S>& wall)
 {
     return {-wall.e * in.u, wall.c_sW * in.W + wall.c_ss * in.v, wall.c_Ws * in.v + wall.c_WW * in.W};
 }
@@ -64,8 +76,8 @@ constexpr Velocities<T> wall_impact(const Velocities<T>& in, const ImpactMatrix&
 //   u_{n+1} = (1/7)(5-2 alpha_floor) u+ - (2/7)(1+alpha_floor) W+
 //   W_{n+1} = -(5/7)(1+alpha_floor) u+ + (1/7)(2-5 alpha_floor) W+
 //   v_{n+1} = -e_floor v_f
-template <class T>
-constexpr Velocities<T> floor_impact(const Velocities<T>& in, const ImpactMatrix& floor)
+template <class T, class S>
+constexpr Velocities<T> floor_impact(const Velocities<T>& in, const BasicImpactMatrix<S>& floor)
 {
     return {floor.c_ss * in.u - floor.c_sW * in.W, -floor.e * in.v, floor.c_WW * in.W - floor.c_Ws * in.u};
 }

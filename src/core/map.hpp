@@ -120,8 +120,9 @@ struct CanonicalStep {
 // flight back is computed without cancellation (flight_to_floor), so G keeps full
 // relative precision near the boundary planes xi -> 0 and xi -> 1. Valid for xi < 1;
 // xi' is meaningful when U' < 0.
-template <class T>
-constexpr CanonicalStep<T> canonical_map(const CanonicalState<T>& c, const ModelMatrices& m)
+// S: the coefficients' number type (double; in continuation, a differentiated parameter).
+template <class T, class S>
+constexpr CanonicalStep<T> canonical_map(const CanonicalState<T>& c, const BasicModelMatrices<S>& m)
 {
     const T t_wall = 2.0 * c.xi;
     const T y = t_wall * (1.0 - c.xi);

@@ -1,15 +1,33 @@
-// XDMF sidecar: lets ParaView and VisIt open a 2-D or 3-D result directly.
+// XDMF sidecar: lets ParaView and VisIt open a result directly (ParaView's legacy XDMF
+// reader and its Xdmf3 readers, checked by tests/paraview).
+//
+// The mesh is always 3-D rectilinear, one node per sample: a 2-D (or 1-D) result gets
+// its missing dimensions from the job's fixed coordinates, one sample thick at their value,
+// in the order of the coordinates (a (xi, W) slice at U = -1 sits at U = -1 inside the
+// (xi, U, W) volume, with the same axes); the legacy reader draws 2-D meshes as a line.
+// XDMF's X varies fastest: X is the last axis of the mesh, Z the first (canonical: X = W,
+// Y = U, Z = xi). Counts are declared signed (HDF5 converts on read) so that VTK's
+// interpolation between samples cannot wrap around zero as it does on unsigned 16-bit
+// values.
 #pragma once
 
 #include <filesystem>
-
-#include "result_file.hpp"
+#include <string>
+#include <string_view>
 
 namespace superball {
 
-// Writes `<result>.xmf` next to `result` (a rectilinear grid whose nodes are the
-// cell-centred samples) and returns its path; 1-D results get none (XDMF has no 1-D
-// rectilinear mesh) and an empty path is returned.
-std::filesystem::path write_xdmf(const std::filesystem::path& result, const ResultInfo& info);
+// Writes the sidecar of the complete result at `result` (layout::sidecar_path), naming the
+// result by its file name, so the pair keeps working when moved together and from any
+// working directory. Returns its path; empty, writing nothing, for a 4-D result (XDMF has
+// no 4-D mesh) and a result whose file name has a colon (XDMF cannot name it) or the
+// extension .xmf.
+std::filesystem::path write_xdmf(const std::filesystem::path& result);
+
+// Why `result` gets no sidecar ("" if it gets one).
+std::string xdmf_unsupported(const std::filesystem::path& result);
+
+// `text` with the five XML special characters escaped.
+std::string xml_escape(std::string_view text);
 
 }  // namespace superball

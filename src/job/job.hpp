@@ -67,6 +67,16 @@ struct Job {
     // [run] refine: 0 computes every point; a power of two s computes every s-th point
     // and subdivides only the cells whose corners disagree (explore/refine.hpp).
     std::uint32_t refine = 0;
+    // How the result is written; none of these changes a single count, so none is part of
+    // the fingerprint. [run] compression: deflate level of the final result (0: none).
+    int compression = 4;
+    // [run] alignment: large objects of the files (the data of each dataset) start at a
+    // multiple of this many bytes, and ranks write in multiples of it where they can: the
+    // stripe size of a Lustre or GPFS file system.
+    std::uint64_t alignment = std::uint64_t{1} << 20;
+    // [run] checkpoint_seconds: rank 0 records the finished tiles (the resume journal) at
+    // most this often, and when the run ends or stops.
+    double checkpoint_seconds = 10.0;
     std::string text;                     // the job file's text, stored in results
 
     // The range axes, in result order: swept parameters, then coordinates (1 to 4 in all).

@@ -36,7 +36,8 @@ constexpr std::int64_t max_max_bounces = std::numeric_limits<std::uint32_t>::max
 const std::vector<std::string> top_level_keys = {"model", "grid", "run"};
 const std::vector<std::string> model_keys = {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "g", "radius"};
 const std::vector<std::string> range_keys = {"min", "max", "n"};
-const std::vector<std::string> run_keys = {"max_bounces", "output", "tile_points", "refine"};
+const std::vector<std::string> run_keys = {"max_bounces", "output",      "tile_points", "refine",
+                                           "compression", "alignment", "checkpoint_seconds"};
 
 [[noreturn]] void fail(const std::string& message) { throw InputError(message); }
 
@@ -442,6 +443,23 @@ void parse_run(const toml::table* run, Job& job)
         const auto r = integer_in(*n, "[run] refine", 0, 64, accepted);
         if ((r & (r - 1)) != 0) fail("[run] refine = " + std::to_string(r) + " is out of range: accepted " + accepted);
         job.refine = static_cast<std::uint32_t>(r);
+    }
+    if (const toml::node* n = run->get("compression")) {
+        job.compression = static_cast<int>(
+            integer_in(*n, "[run] compression", 0, 9, "0 (uncompressed) to 9 (deflate level; 1 fastest, 9 smallest)"));
+    }
+    if (const toml::node* n = run->get("alignment")) {
+        constexpr const char* accepted = "a power of two from 4096 to 1073741824 bytes (the file system's stripe size)";
+        const auto a = integer_in(*n, "[run] alignment", 4096, std::int64_t{1} << 30, accepted);
+        if ((a & (a - 1)) != 0) fail("[run] alignment = " + std::to_string(a) + " is out of range: accepted " + accepted);
+        job.alignment = static_cast<std::uint64_t>(a);
+    }
+    if (const toml::node* n = run->get("checkpoint_seconds")) {
+        const double c = finite_number(*n, "[run] checkpoint_seconds");
+        if (!(c >= 0.01 && c <= 86400.0)) {
+            fail("[run] checkpoint_seconds = " + as_written(*n) + " is out of range: accepted 0.01 to 86400 (seconds)");
+        }
+        job.checkpoint_seconds = c;
     }
 }
 

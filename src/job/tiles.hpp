@@ -9,6 +9,13 @@ namespace superball {
 
 using Extent = std::vector<std::uint64_t>;  // one entry per range axis, first axis slowest
 
+// A finished tile, as its writer reports it: which tile, and the checksum of its data as
+// written (the resume journal keeps it; a resume checks the data against it).
+struct TileReport {
+    std::uint64_t tile = 0;
+    std::uint64_t checksum = 0;
+};
+
 // A block of the grid: [start, start + count) along each axis.
 struct Box {
     Extent start;

@@ -1,6 +1,66 @@
 #include "mpi.hpp"
 
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
 namespace superball::mpi {
+
+namespace {
+
+bool is_set(const Getenv& getenv, const char* name) { return getenv(name) != nullptr; }
+
+// Whether an MCA parameter file sets `key` (lines `key = value`, `#` comments).
+bool sets_key(std::string_view params, std::string_view key)
+{
+    std::istringstream in{std::string(params)};
+    for (std::string line; std::getline(in, line);) {
+        if (const auto comment = line.find('#'); comment != std::string::npos) line.resize(comment);
+        const auto eq = line.find('=');
+        if (eq == std::string::npos) continue;
+        std::string_view name(line.data(), eq);
+        while (!name.empty() && (name.front() == ' ' || name.front() == '\t')) name.remove_prefix(1);
+        while (!name.empty() && (name.back() == ' ' || name.back() == '\t')) name.remove_suffix(1);
+        if (name == key) return true;
+    }
+    return false;
+}
+
+std::string user_mca_params(const Getenv& getenv)
+{
+    const char* home = getenv("HOME");
+    if (home == nullptr) return {};
+    std::ifstream in(std::string(home) + "/.openmpi/mca-params.conf");
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view user_params)
+{
+    if (is_set(getenv, "OMPI_MCA_mca_base_param_files")) return {};
+    bool singleton = true;
+    if (const char* size = getenv("OMPI_COMM_WORLD_SIZE")) {
+        const char* local = getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+        if (local == nullptr || std::string_view(local) != size) return {};
+        singleton = false;
+    } else {
+        for (const char* launcher : {"PMIX_RANK", "PMI_RANK", "PMI_SIZE", "PMI_FD"}) {
+            if (is_set(getenv, launcher)) return {};
+        }
+    }
+    std::vector<McaSetting> wanted{{"pml", "ob1"}};
+    if (singleton) wanted.push_back({"ess_singleton_isolated", "1"});
+    std::vector<McaSetting> settings;
+    for (McaSetting& s : wanted) {
+        if (!is_set(getenv, ("OMPI_MCA_" + s.name).c_str()) && !sets_key(user_params, s.name)) {
+            settings.push_back(std::move(s));
+        }
+    }
+    return settings;
+}
 
 void check(int code, const char* what)
 {
@@ -13,12 +73,57 @@ void check(int code, const char* what)
 
 Environment::Environment()
 {
-    // Only `explore` starts MPI, so the command-line arguments are not MPI's business.
-    check(MPI_Init(nullptr, nullptr), "MPI_Init");
+#ifdef OPEN_MPI
+    const Getenv getenv = [](const char* name) { return std::getenv(name); };
+    for (const McaSetting& s : single_node_mca(getenv, user_mca_params(getenv))) {
+        // Never replaces a value (the last argument): single_node_mca() checked there is none.
+        ::setenv(("OMPI_MCA_" + s.name).c_str(), s.value.c_str(), 0);
+        if (s.name == "ess_singleton_isolated" && !is_set(getenv, "OMPI_MCA_orte_tmpdir_base")) {
+            const char* tmp = getenv("TMPDIR");
+            std::string dir = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/superball-mpi-XXXXXX";
+            // Without it the process still runs, sharing the directory as before.
+            if (::mkdtemp(dir.data()) != nullptr) {
+                session_base_ = dir;
+                ::setenv("OMPI_MCA_orte_tmpdir_base", dir.c_str(), 1);
+            }
+        }
+    }
+#endif
+    // The command-line arguments are not MPI's business. FUNNELED: the run's writer threads
+    // (io/posix_file.hpp) make no MPI call, only the main thread does.
+    int provided = MPI_THREAD_SINGLE;
+    if (const int code = MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided); code != MPI_SUCCESS) {
+        std::error_code ignored;
+        if (!session_base_.empty()) std::filesystem::remove_all(session_base_, ignored);
+        check(code, "MPI_Init_thread");
+    }
+    if (provided < MPI_THREAD_FUNNELED) {
+        MPI_Finalize();
+        throw std::runtime_error("MPI_Init_thread: this MPI library cannot run a process with threads (MPI_THREAD_FUNNELED)");
+    }
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
 }
 
-Environment::~Environment() { MPI_Finalize(); }
+Environment::~Environment()
+{
+    MPI_Finalize();
+    if (!session_base_.empty()) {
+        std::error_code ignored;  // a directory left in /tmp is no reason to fail a finished run
+        std::filesystem::remove_all(session_base_, ignored);
+    }
+}
+
+Info::Info() { check(MPI_Info_create(&info_), "MPI_Info_create"); }
+
+Info::~Info()
+{
+    if (info_ != MPI_INFO_NULL) MPI_Info_free(&info_);
+}
+
+void Info::set(const std::string& key, const std::string& value)
+{
+    check(MPI_Info_set(info_, key.c_str(), value.c_str()), "MPI_Info_set");
+}
 
 int Comm::rank() const
 {
@@ -50,6 +155,14 @@ void Comm::broadcast(std::vector<std::uint64_t>& v) const
     check(MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm_), "MPI_Bcast");
     v.resize(n);
     check(MPI_Bcast(v.data(), static_cast<int>(n), MPI_UINT64_T, 0, comm_), "MPI_Bcast");
+}
+
+void Comm::broadcast(std::vector<double>& v) const
+{
+    auto n = static_cast<std::uint64_t>(v.size());
+    check(MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm_), "MPI_Bcast");
+    v.resize(n);
+    check(MPI_Bcast(v.data(), static_cast<int>(n), MPI_DOUBLE, 0, comm_), "MPI_Bcast");
 }
 
 std::int64_t Comm::broadcast(std::int64_t x) const

@@ -5,23 +5,79 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace superball::mpi {
+
+// A failure that every rank of a communicator raises alike, so the ranks are still in step:
+// the caller reports it once and exits normally (no MPI_Abort).
+struct CollectiveError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
 
 // Turns an MPI error code into an exception (MPI_ERRORS_RETURN is set on the world
 // communicator by Environment).
 void check(int code, const char* what);
 
-// MPI_Init / MPI_Finalize for the lifetime of the object. One per process.
+// Open MPI parameters for a run on one node, decided from the environment before MPI_Init
+// (names without the OMPI_MCA_ prefix, with their values). Open MPI's default start-up
+// opens its network transports (UCX, the PSM/PSM2 libraries of the cm layer) whether or not
+// there is a network, and a singleton (a process started without mpirun) first starts a
+// daemon of its own: together 0.2-0.3 s of a 0.35 s job on the 2-core test machine.
+//   pml = ob1                     (shared memory between the ranks, TCP: all one node
+//                                 needs) for a singleton and for an Open MPI mpirun whose
+//                                 ranks are all on this node (OMPI_COMM_WORLD_LOCAL_SIZE =
+//                                 OMPI_COMM_WORLD_SIZE);
+//   ess_singleton_isolated = 1    (no daemon: superball never spawns or connects to other
+//                                 processes) for a singleton.
+// A parameter the user set is left alone: OMPI_MCA_<name> in the environment, even set to
+// nothing (also how `mpirun --mca NAME VALUE` reaches the ranks), or a line in
+// `user_params`, the text of ~/.openmpi/mca-params.conf; and nothing is set when other
+// parameter files are named (OMPI_MCA_mca_base_param_files), when the ranks span several
+// nodes (InfiniBand or Omni-Path is then what they need), or when another launcher started
+// the process (srun, MPICH's hydra: PMI or PMIx variables without Open MPI's), which says
+// nothing here about the number of nodes.
+struct McaSetting {
+    std::string name;
+    std::string value;
+    friend bool operator==(const McaSetting&, const McaSetting&) = default;
+};
+using Getenv = std::function<const char*(const char* name)>;
+std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view user_params);
+
+// MPI_Init / MPI_Finalize for the lifetime of the object. One per process. With Open MPI,
+// sets the parameters of single_node_mca() first. An isolated singleton also gets a session
+// directory of its own (orte_tmpdir_base, a fresh directory under $TMPDIR or /tmp, removed
+// after MPI_Finalize): isolated singletons all take the job family 0, so two started at the
+// same moment create and remove the same <tmp>/ompi.<host>.<uid>/jf.0 and one of them fails
+// in orte_init ("A call to mkdir was unable to create the desired directory", ompi#3818).
 class Environment {
 public:
     Environment();
     ~Environment();
     Environment(const Environment&) = delete;
     Environment& operator=(const Environment&) = delete;
+
+private:
+    std::string session_base_;  // the private session directory, or empty
+};
+
+// An MPI_Info object of hints (MPI-IO's, here), freed with the object.
+class Info {
+public:
+    Info();
+    ~Info();
+    Info(const Info&) = delete;
+    Info& operator=(const Info&) = delete;
+    void set(const std::string& key, const std::string& value);
+    MPI_Info get() const { return info_; }
+
+private:
+    MPI_Info info_ = MPI_INFO_NULL;
 };
 
 // A communicator borrowed from MPI (not freed here).
@@ -39,6 +95,7 @@ public:
     // Rank 0's value on every rank.
     void broadcast(std::string& s) const;
     void broadcast(std::vector<std::uint64_t>& v) const;
+    void broadcast(std::vector<double>& v) const;
     std::int64_t broadcast(std::int64_t x) const;
     double broadcast(double x) const;
     // Element-wise sum over ranks, result on every rank.

@@ -12,9 +12,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/kernels.hpp"
 #include "job/job.hpp"
 #include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
@@ -23,13 +25,14 @@
 
 namespace superball {
 
-enum class KernelChoice { simd, scalar };
+// A failure that every rank of a run raises alike (the ranks are in step): reported once.
+using RunError = mpi::CollectiveError;
 
 struct ExploreSettings {
     std::filesystem::path output;  // the result file; empty: the job's [run] output
     bool resume = false;           // finish an interrupted run of the same job
     bool overwrite = false;        // replace an existing result
-    KernelChoice kernel = KernelChoice::simd;
+    CountKernel kernel = best_kernel().count;  // core/kernels.hpp: select_kernel()
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]
@@ -45,10 +48,12 @@ struct ExplorePlan {
     std::string note;  // for the user: what was decided and why (may be empty)
 };
 
-// Collective. Throws InputError (on every rank, same text) when the output must not be
-// touched: it exists and neither --resume nor --overwrite says what to do with it, it is
-// not a superball result, it belongs to another job or version, it is damaged, or it
-// cannot be written.
+// Collective. Decides on rank 0 what to do with the output (a result, written when the run
+// completes) and its partial file (OUTPUT.partial, the run in progress), and tells every
+// rank. Throws InputError (on every rank, same text) when they must not be touched: the
+// output exists and neither --resume nor --overwrite says what to do with it, it is not a
+// superball file (never replaced, even with --overwrite), it belongs to another job or
+// version, or it cannot be written.
 ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm);
 
 struct RunSummary {
@@ -60,14 +65,19 @@ struct RunSummary {
     std::uint64_t points_counted = 0;     // of which counted by the kernel (fewer with refinement)
     std::vector<std::uint64_t> outcomes;  // histogram of this run's points by outcome code
     double compute_seconds = 0;           // from the first tile handed out to the last one done
+    double finish_seconds = 0;            // writing the result from the partial file
+    std::uint64_t raw_bytes = 0;          // of the data, uncompressed
+    std::uint64_t result_bytes = 0;       // of the result file
+    std::string sidecar_note;             // "sidecar: PATH", or why the result has none
     double peak_rss_mib = 0;              // largest over the ranks
     int ranks = 1;
 };
 
 // Collective over `comm`: plans (plan_explore), runs and finishes the job. Returns on
 // every rank; the summary's figures are valid on every rank. Throws InputError (every
-// rank) when planning refuses; other exceptions mean the ranks may be out of step, and
-// the caller should end them all (mpi::Comm::abort).
+// rank) when planning refuses, RunError (every rank) when the files cannot be made or
+// finished; other exceptions mean the ranks may be out of step, and the caller should end
+// them all (mpi::Comm::abort).
 RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm, RunObserver& observer,
                        const StopRequested& stop);
 

@@ -78,4 +78,11 @@ void TerminalProgress::computed(double seconds)
     if (!quiet_ && total_tiles_ > 0) report(true);
 }
 
+void TerminalProgress::finishing()
+{
+    if (quiet_) return;
+    fmt::print(out_, "writing the result: compressing and writing every tile from the partial file\n");
+    std::fflush(out_);
+}
+
 }  // namespace superball

@@ -30,8 +30,10 @@ public:
     virtual void started(const RunStart&) {}
     // `tiles` more tiles of `points` points in all are done.
     virtual void tiles_done(std::uint64_t /*tiles*/, std::uint64_t /*points*/) {}
-    // The compute phase is over (before the result is closed).
+    // The compute phase is over (before the result is written).
     virtual void computed(double /*seconds*/) {}
+    // Every tile is done: the result is being written from the partial file.
+    virtual void finishing() {}
 };
 
 // Prints the plan's note and the start line, then tiles done, points/s, elapsed time and
@@ -44,6 +46,7 @@ public:
     void started(const RunStart& s) override;
     void tiles_done(std::uint64_t tiles, std::uint64_t points) override;
     void computed(double seconds) override;
+    void finishing() override;
 
 private:
     void report(bool final);

@@ -127,11 +127,9 @@ public:
         }
         // Within a tile too: a server answers the ranks it serves, a served rank its
         // server's requests for tiles back.
-        if (!children_.empty() || !root_) {
-            serve_ = [this] { poll(); };
-        } else {
-            serve_ = [] {};
-        }
+        // A lone rank has no one to answer: its Serve stays empty, and the counter never
+        // stops for it.
+        if (!children_.empty() || !root_) serve_ = [this] { poll(); };
     }
 
     void run()

@@ -25,20 +25,15 @@
 #include <span>
 #include <vector>
 
+#include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
 
 namespace superball {
 
 // The rank that schedules calls `serve` from inside its own work every few hundred
-// points, so that waiting ranks get their next block promptly; elsewhere it does nothing.
+// points, so that waiting ranks get their next block promptly; elsewhere (and when no
+// other rank waits: a run on one rank) it is empty.
 using Serve = std::function<void()>;
-
-// What a finished tile tells the scheduler: which tile, and the checksum of its data as
-// written (for the resume journal).
-struct TileReport {
-    std::uint64_t tile = 0;
-    std::uint64_t checksum = 0;
-};
 
 // What a rank does with the tiles it is given.
 class TileWork {

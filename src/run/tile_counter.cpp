@@ -7,8 +7,14 @@ namespace superball {
 void count_in_blocks(CountKernel kernel, const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                      std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes, const Serve& serve)
 {
-    // Small enough that rank 0 answers requests within milliseconds even where every
-    // point bounces to max_bounces, large enough to fill the vector kernel.
+    // Nothing to serve: one call, so the vector kernel refills its lanes to the end instead
+    // of draining them at the end of every block (4% fewer instructions with 2 lanes).
+    if (!serve) {
+        kernel(starts, m, max_bounces, wall_bounces, outcomes);
+        return;
+    }
+    // Small enough that the scheduling rank answers requests within milliseconds even where
+    // every point bounces to max_bounces, large enough to fill the vector kernel.
     constexpr std::size_t block = 512;
     for (std::size_t i = 0; i < starts.size(); i += block) {
         const std::size_t n = std::min(block, starts.size() - i);

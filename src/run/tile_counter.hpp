@@ -7,16 +7,14 @@
 #include <vector>
 
 #include "core/count.hpp"
+#include "core/kernels.hpp"
 #include "job/grid.hpp"
 #include "run/schedule.hpp"
 
 namespace superball {
 
-// count_each() or count_each_simd().
-using CountKernel = void (*)(const StartsView&, const ModelMatrices&, std::uint32_t, std::span<std::uint32_t>,
-                             std::span<std::uint8_t>);
-
-// Runs `kernel` over `starts` in blocks, calling `serve` between blocks.
+// Runs `kernel` over `starts` in blocks, calling `serve` between blocks; in one call when
+// `serve` is empty (no rank is waiting to be served).
 void count_in_blocks(CountKernel kernel, const StartsView& starts, const ModelMatrices& m, std::uint32_t max_bounces,
                      std::span<std::uint32_t> wall_bounces, std::span<std::uint8_t> outcomes, const Serve& serve);
 

@@ -1,16 +1,18 @@
 // Microbenchmarks of the map step and the counting kernels (Google Benchmark).
 //
-//   build/native/tests/bench/bench_kernel            (the native preset: -march=native)
+//   build/release/tests/bench/bench_kernel --benchmark_filter=count_slice
 //
-// Reported: ns per map iteration (items = iterations of G) and points/s of the kernels
-// on the issue-4 slice U = -1, xi in (0, 1), W in [-3, 3], e = alpha = 0.9.
+// Reported: ns per map iteration (items = iterations of G) and points/s of the scalar
+// kernel and of every variant of the vectorised kernel this processor runs
+// (core/kernels.hpp) on the issue-4 slice U = -1, xi in (0, 1), W in [-3, 3],
+// e = alpha = 0.9. The context line "superball" names the variants.
 #include <benchmark/benchmark.h>
 
-#include <random>
+#include <string>
 #include <vector>
 
 #include "core/count.hpp"
-#include "core/count_simd.hpp"
+#include "core/kernels.hpp"
 
 namespace {
 
@@ -61,20 +63,15 @@ void BM_physical_map(benchmark::State& state)
 }
 BENCHMARK(BM_physical_map);
 
-// Counts every start once per iteration with the scalar or the vectorised kernel;
-// items are points, and the counter the time per iteration of G.
-template <bool simd>
-void run_kernel(benchmark::State& state, const std::vector<CanonicalState<double>>& starts)
+// Counts every start once per iteration with `kernel`; items are points, and the counter
+// the time per iteration of G.
+void run_kernel(benchmark::State& state, const KernelVariant& kernel, const std::vector<CanonicalState<double>>& starts)
 {
     std::vector<std::uint32_t> wb(starts.size());
     std::vector<std::uint8_t> oc(starts.size());
     const Starts points = Starts::of(starts);
     for (auto _ : state) {
-        if constexpr (simd) {
-            count_each_simd(points.view(), slice_model, 1000, wb, oc);
-        } else {
-            count_each(points.view(), slice_model, 1000, wb, oc);
-        }
+        kernel.count(points.view(), slice_model, 1000, wb, oc);
         benchmark::ClobberMemory();
     }
     std::uint64_t iterations = 0;
@@ -82,31 +79,51 @@ void run_kernel(benchmark::State& state, const std::vector<CanonicalState<double
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * starts.size()));
     state.counters["time_per_map_iteration"] = benchmark::Counter(
         static_cast<double>(state.iterations() * iterations), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.SetLabel(describe(kernel));
 }
-
-template <bool simd>
-void BM_count_slice(benchmark::State& state)
-{
-    run_kernel<simd>(state, slice(static_cast<std::size_t>(state.range(0))));
-}
-// 4096: the full benchmark slice of tests/bench/run.sh (16.7 M points).
-BENCHMARK_TEMPLATE(BM_count_slice, false)->Arg(512)->Arg(4096)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_count_slice, true)->Arg(512)->Arg(4096)->Unit(benchmark::kMillisecond);
 
 // Long-lived points only (the region xi < 0.05, W < -2 of the slice, where counts are
 // highest): measures the arithmetic throughput of the kernels rather than lane refill.
-template <bool simd>
-void BM_count_long_lived(benchmark::State& state)
+std::vector<CanonicalState<double>> long_lived()
 {
     std::vector<CanonicalState<double>> starts;
     for (int i = 0; i < 64; ++i) {
         for (int k = 0; k < 64; ++k) starts.push_back({0.0005 + 0.0007 * i, -1.0, -2.99 + 0.015 * k});
     }
-    run_kernel<simd>(state, starts);
+    return starts;
 }
-BENCHMARK_TEMPLATE(BM_count_long_lived, false)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_count_long_lived, true)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// The kernels by name: BM_count_slice/<kernel>/<n> for the scalar kernel and every
+// vectorised variant this processor runs (4096: the full benchmark slice of
+// tests/bench/run.sh, 16.7 M points), BM_count_long_lived/<kernel>. Rates per second of
+// wall time, as explore reports its own: on a shared machine the processor time of one
+// thread overstates what a run gets.
+int main(int argc, char** argv)
+{
+    std::vector<const KernelVariant*> kernels{&scalar_kernel()};
+    for (const KernelVariant& k : simd_kernels()) {
+        if (k.runs_here()) kernels.push_back(&k);
+    }
+    for (const KernelVariant* k : kernels) {
+        for (const std::size_t n : {512, 4096}) {
+            benchmark::RegisterBenchmark(("BM_count_slice/" + std::string(k->name) + "/" + std::to_string(n)).c_str(),
+                                         [k, n](benchmark::State& state) { run_kernel(state, *k, slice(n)); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+        }
+    }
+    for (const KernelVariant* k : kernels) {
+        benchmark::RegisterBenchmark(("BM_count_long_lived/" + std::string(k->name)).c_str(),
+                                     [k](benchmark::State& state) { run_kernel(state, *k, long_lived()); })
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
+    }
+    benchmark::AddCustomContext("superball", kernel_report());
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}

@@ -1,108 +1,341 @@
 #!/usr/bin/python3
-"""Runs the issue-4 benchmark and prints its table; see tests/bench/run.sh."""
+"""Runs the speed benchmarks and prints their tables; see tests/bench/run.sh.
+
+Every figure is the median of --repetitions (at least 3) repetitions, and the
+repetitions are interleaved: each one runs every measurement once, in the same order, so
+that the load of a shared machine falls on all of them alike. Every ratio is taken within
+one repetition (the runs it compares ran back to back) and its median reported, with the
+smallest and largest in brackets.
+"""
 import argparse
 import datetime
 import json
 import os
 import platform
 import re
+import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
+# The benchmark slice (tests/bench/slice_4096.toml) at any size n.
+SLICE = """[model]
+e = 0.9
+alpha = 0.9
 
-def kernel_rates(bench, n):
-    """Points/s of the scalar and the vectorised kernel on the n x n slice."""
-    out = subprocess.run([bench, f"--benchmark_filter=BM_count_slice<(false|true)>/{n}$", "--benchmark_format=json",
-                          "--benchmark_min_time=1"], capture_output=True, text=True, check=True).stdout
+[grid]
+coordinates = "canonical"
+xi = {{ min = 0.0, max = 1.0, n = {n} }}
+U = -1.0
+W = {{ min = -3.0, max = 3.0, n = {n} }}
+
+[run]
+max_bounces = 1000
+{run}"""
+
+# Issue 12's trivial grid: every launch misses the wall (xi >= 1), so a run costs what the
+# tiles cost beyond their points.
+TRIVIAL = """[model]
+e = 0.9
+alpha = 0.9
+
+[grid]
+xi = {{ min = 1.0, max = 2.0, n = 8192 }}
+U = -1.0
+W = {{ min = -3.0, max = 3.0, n = 8192 }}
+
+[run]
+max_bounces = 1000
+tile_points = {tile}
+"""
+
+
+def median(values):
+    return statistics.median(values)
+
+
+def spread(values, fmt):
+    return f"[{fmt.format(min(values))}, {fmt.format(max(values))}]"
+
+
+class Builds:
+    """The superball and bench_kernel binaries of one build tree."""
+
+    def __init__(self, directory):
+        self.dir = directory
+        self.superball = os.path.abspath(os.path.join(directory, "src", "superball"))
+        self.bench = os.path.abspath(os.path.join(directory, "tests", "bench", "bench_kernel"))
+        for path in (self.superball, self.bench):
+            if not os.access(path, os.X_OK):
+                sys.exit(f"run_benchmarks: {path} is missing: build it (tests/bench/run.sh does)")
+        version = subprocess.run([self.superball, "--version"], capture_output=True, text=True, check=True,
+                                 env=without_kernel_choice())
+        self.version = " ".join(version.stdout.split())
+        self.kernel = re.search(r"counting kernel: (\S+)", version.stdout).group(1)
+        self.kernel_text = re.search(r"counting kernel: ([^;]+);", version.stdout).group(1)
+
+
+def without_kernel_choice(**extra):
+    env = dict(os.environ)
+    env.pop("SUPERBALL_KERNEL", None)
+    env.update(extra)
+    return env
+
+
+def kernel_rates(build, n, kernels, min_time):
+    """Points/s (wall time) and ns per iteration of G of `kernels` on the n x n slice."""
+    names = "|".join(kernels)
+    out = subprocess.run([build.bench, f"--benchmark_filter=^BM_count_slice/({names})/{n}/real_time$",
+                          "--benchmark_format=json", f"--benchmark_min_time={min_time}"],
+                         capture_output=True, text=True, check=True).stdout
     rates = {}
     for b in json.loads(out)["benchmarks"]:
-        kind = "vectorised" if "<true>" in b["name"] else "scalar"
-        rates[kind] = (b["items_per_second"], b["time_per_map_iteration"] * 1e9)
+        kernel = b["name"].split("/")[1]
+        rates[kernel] = (b["items_per_second"], b["time_per_map_iteration"] * 1e9, b.get("label", kernel))
+    missing = set(kernels) - set(rates)
+    if missing:
+        sys.exit(f"run_benchmarks: {build.bench} has no kernel {', '.join(sorted(missing))}")
     return rates
 
 
-def explore(superball, job, ranks, workdir, keep=None):
-    """(points/s as explore reports it, wall seconds of the whole command, peak MiB per
-    rank); the result is deleted unless `keep` names it."""
-    out = os.path.join(workdir, keep or f"r{ranks}.h5")
-    cmd = ["mpirun", "-n", str(ranks), "--oversubscribe", superball, "explore", job, "-o", out, "--overwrite", "-q"]
-    start = datetime.datetime.now()
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    wall = (datetime.datetime.now() - start).total_seconds()
-    if r.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed:\n{r.stderr}")
-    rate = float(re.search(r"\(([0-9.e+]+) points/s\)", r.stderr).group(1))
-    peak = float(re.search(r"peak memory per rank: ([0-9.]+) MiB", r.stderr).group(1))
-    if not keep:
-        os.remove(out)
-    return rate, wall, peak
+def runnable_kernels(build):
+    out = subprocess.run([build.bench, "--benchmark_list_tests=true", "--benchmark_filter=^BM_count_slice/.*/4096/real_time$"],
+                         capture_output=True, text=True, check=True).stdout
+    return [line.split("/")[1] for line in out.split()]
 
 
-def refinement(superball, job_text, name, workdir):
-    """Full computation against refine = 8 on one grid, 2 ranks: (speed-up, mismatch)."""
+class Explorer:
+    def __init__(self, workdir):
+        self.workdir = workdir
+        self.serial = 0
+
+    def job(self, text):
+        self.serial += 1
+        path = os.path.join(self.workdir, f"job{self.serial}.toml")
+        with open(path, "w") as f:
+            f.write(text)
+        return path
+
+    def run(self, build, job, ranks, keep=None, wrap=(), env=None, singleton=False):
+        """Runs explore; returns (points/s as explore reports it, seconds of its compute
+        phase, wall seconds of the whole command, peak MiB per rank, output path). The
+        result is deleted unless `keep`."""
+        out = os.path.join(self.workdir, keep or "run.h5")
+        launcher = [] if singleton else ["mpirun", "-n", str(ranks), "--oversubscribe"]
+        cmd = [*wrap, *launcher, build.superball, "explore", job, "-o", out, "--overwrite", "-q"]
+        start = datetime.datetime.now()
+        r = subprocess.run(cmd, capture_output=True, text=True, env=env or without_kernel_choice())
+        wall = (datetime.datetime.now() - start).total_seconds()
+        if r.returncode != 0:
+            sys.exit(f"{' '.join(cmd)} failed:\n{r.stderr}")
+        m = re.search(r"(\d+) points computed in [0-9.]+ s \(([0-9.e+]+) points/s\)", r.stderr)
+        points, rate = int(m.group(1)), float(m.group(2))
+        peak = float(re.search(r"peak memory per rank: ([0-9.]+) MiB", r.stderr).group(1))
+        if not keep:
+            remove_outputs(out)
+        return {"rate": rate, "compute": points / rate, "wall": wall, "peak": peak, "output": out, "stderr": r.stderr}
+
+
+def remove_outputs(out):
+    """A result, the file a run writes before renaming it, and the XDMF sidecar."""
+    for path in (out, out + ".partial", os.path.splitext(out)[0] + ".xmf"):
+        if os.path.exists(path):
+            os.remove(path)
+
+
+def write_calls(explorer, build, job, ranks, name):
+    """Write system calls to the result file (any path containing its base name, so that a
+    `.partial` file written first counts too), as /work/shared/tools/write-calls.sh counts
+    them: strace of every process, the calls write, pwrite64, pwritev, pwritev2."""
+    trace = os.path.join(explorer.workdir, "trace")
+    shutil.rmtree(trace, ignore_errors=True)
+    os.makedirs(trace)
+    strace = ["strace", "-ff", "-qq", "-y", "-e", "trace=write,pwrite64,pwritev,pwritev2", "-o",
+              os.path.join(trace, "t")]
+    if subprocess.run(["strace", "--seccomp-bpf", "-f", "-qq", "-e", "trace=none", "true"],
+                      capture_output=True).returncode == 0:
+        strace.insert(1, "--seccomp-bpf")  # only the traced calls stop the processes
+    explorer.run(build, job, ranks, keep=name, wrap=strace)
+    calls = 0
+    written = 0
+    for entry in os.listdir(trace):
+        with open(os.path.join(trace, entry), errors="replace") as f:
+            for line in f:
+                m = re.search(r"= (\d+)$", line.rstrip())
+                if name in line and m:
+                    calls += 1
+                    written += int(m.group(1))
+    shutil.rmtree(trace)
+    remove_outputs(os.path.join(explorer.workdir, name))
+    return calls, written
+
+
+def refinement_mismatch(a, b):
     import h5py  # Debian's python3-h5py
-    results = {}
-    for refine in (0, 8):
-        job = os.path.join(workdir, f"{name}-{refine}.toml")
-        with open(job, "w") as f:
-            f.write(job_text.replace("[run]", f"[run]\nrefine = {refine}"))
-        rate, _, _ = explore(superball, job, 2, workdir, keep=f"{name}-{refine}.h5")
-        with h5py.File(os.path.join(workdir, f"{name}-{refine}.h5"), "r") as f:
-            results[refine] = (rate, f["wall_bounces"][()], f["outcome"][()])
-    (rate0, w0, o0), (rate8, w8, o8) = results[0], results[8]
-    return rate8 / rate0, float(((w0 != w8) | (o0 != o8)).mean())
+    with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+        return float(((fa["wall_bounces"][()] != fb["wall_bounces"][()]) | (fa["outcome"][()] != fb["outcome"][()])).mean())
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--build", default="build/native", help="build directory with superball and bench_kernel")
-    p.add_argument("--skip-16384", action="store_true", help="skip the 16384^2 memory run (1.2 GB of output)")
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--portable", default="build/release", help="portable build tree (default build/release)")
+    p.add_argument("--native", default="build/native",
+                   help="-march=native build tree (default build/native); 'none' to skip the comparison")
+    p.add_argument("--repetitions", type=int, default=3, help="interleaved repetitions, at least 3 (default 3)")
+    p.add_argument("--quick", action="store_true",
+                   help="shorter kernel timings; no 16384^2 memory run and no refinement table")
+    p.add_argument("--skip-16384", action="store_true", help="skip the 16384^2 memory run (0.8 GB of output)")
     a = p.parse_args()
-    bench = os.path.join(a.build, "tests/bench/bench_kernel")
-    superball = os.path.abspath(os.path.join(a.build, "src/superball"))
+    if a.repetitions < 3:
+        p.error("--repetitions: at least 3 (every figure is a median of at least 3)")
+    if shutil.which("strace") is None:
+        sys.exit("run_benchmarks: strace is missing (.ci/install-deps --bench installs it)")
+    portable = Builds(a.portable)
+    native = Builds(a.native) if a.native != "none" else None
+    min_time = 0.3 if a.quick else 1.0
+    kernels = runnable_kernels(portable)
+    best = portable.kernel
+
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-    print(f"machine: {cpu}, {os.cpu_count()} cores; {platform.platform()}; {datetime.date.today()}", flush=True)
+    print(f"machine: {cpu}, {os.cpu_count()} cores; {platform.platform()}; {datetime.date.today()}")
+    print(f"portable build ({portable.dir}): {portable.version}")
+    if native:
+        print(f"native build ({native.dir}): {native.version}")
+    print(f"{a.repetitions} interleaved repetitions; medians, [smallest, largest] of the ratios", flush=True)
 
-    k = kernel_rates(bench, 4096)
-    scalar = k["scalar"][0]
-    rows = [("scalar kernel, 1 core", scalar, f"{k['scalar'][1]:.2f} ns/iteration"),
-            ("vectorised kernel, 1 core", k["vectorised"][0], f"{k['vectorised'][1]:.2f} ns/iteration")]
-    peaks = {}
+    r = {key: [] for key in ("kernel", "native_kernel", "n1", "n2", "p8192", "n8192", "tile1024", "tile262144",
+                             "calls", "single", "single_before", "mpirun", "mpirun_before", "n2_16384",
+                             "refine_slice", "refine_volume", "full_slice", "coarse_slice", "full_volume",
+                             "coarse_volume")}
+    mismatch = {}
     with tempfile.TemporaryDirectory(prefix="superball-bench-") as d:
-        job = os.path.join(HERE, "slice_4096.toml")
-        for ranks in (1, 2):
-            rate, wall, peak = explore(superball, job, ranks, d)
-            rows.append((f"explore -n {ranks}", rate, f"{wall:.2f} s wall incl. start-up, peak {peak:.0f} MiB/rank"))
-            peaks[(4096, ranks)] = peak
-        if not a.skip_16384:
-            rate, wall, peak = explore(superball, os.path.join(HERE, "slice_16384.toml"), 2, d)
-            rows.append(("explore -n 2, 16384^2", rate, f"{wall:.2f} s wall, peak {peak:.0f} MiB/rank"))
-            peaks[(16384, 2)] = peak
-
-        slice_text = open(os.path.join(HERE, "slice_4096.toml")).read()
+        ex = Explorer(d)
+        slice_4096 = os.path.join(HERE, "slice_4096.toml")
+        slice_8192 = ex.job(SLICE.format(n=8192, run=""))
+        slice_64 = ex.job(SLICE.format(n=64, run=""))
+        tiles_1024 = ex.job(TRIVIAL.format(tile=1024))
+        tiles_262144 = ex.job(TRIVIAL.format(tile=262144))
+        slice_text = SLICE.format(n=4096, run="")
         volume_text = slice_text.replace("U = -1.0", "U = { min = -3.0, max = -0.05, n = 256 }").replace(
             "n = 4096", "n = 256")
-        refined = [("4096^2 slice", *refinement(superball, slice_text, "slice", d)),
-                   ("256^3 volume, U in [-3, -0.05]", *refinement(superball, volume_text, "volume", d))]
+        refine_jobs = {(name, refine): ex.job(text.replace("[run]", f"[run]\nrefine = {refine}"))
+                       for name, text in (("slice", slice_text), ("volume", volume_text)) for refine in (0, 8)}
+        for rep in range(a.repetitions):
+            print(f"repetition {rep + 1} of {a.repetitions}", file=sys.stderr, flush=True)
+            # Each pair runs A B in even repetitions and B A in odd ones: neither always
+            # follows the other (the page cache's writeback of one run's output slows the next).
+            def pair(key_a, run_a, key_b, run_b):
+                for key, run in ((key_a, run_a), (key_b, run_b)) if rep % 2 == 0 else ((key_b, run_b), (key_a, run_a)):
+                    r[key].append(run())
 
+            if native:
+                pair("kernel", lambda: kernel_rates(portable, 4096, kernels, min_time),
+                     "native_kernel", lambda: kernel_rates(native, 4096, [native.kernel], min_time)[native.kernel])
+            else:
+                r["kernel"].append(kernel_rates(portable, 4096, kernels, min_time))
+            pair("n1", lambda: ex.run(portable, slice_4096, 1), "n2", lambda: ex.run(portable, slice_4096, 2))
+            # Issue 14: the portable binary against the native build, one rank, 8192^2.
+            if native:
+                pair("p8192", lambda: ex.run(portable, slice_8192, 1), "n8192", lambda: ex.run(native, slice_8192, 1))
+            # Issue 12: cost of a tile beyond its points, one rank.
+            pair("tile1024", lambda: ex.run(portable, tiles_1024, 1), "tile262144",
+                 lambda: ex.run(portable, tiles_262144, 1))
+            r["calls"].append(write_calls(ex, portable, slice_8192, 2, "calls-8192.h5"))
+            # Start-up of a 64^2 job: superball's choice on one node (ob1; no daemon for a
+            # singleton) and Open MPI's own (the parameters set by hand, to nothing and to
+            # its default, which superball leaves alone).
+            own = without_kernel_choice(OMPI_MCA_pml="", OMPI_MCA_ess_singleton_isolated="0")
+            for _ in range(2):
+                pair("single", lambda: ex.run(portable, slice_64, 1, singleton=True)["wall"],
+                     "single_before", lambda: ex.run(portable, slice_64, 1, singleton=True, env=own)["wall"])
+                pair("mpirun", lambda: ex.run(portable, slice_64, 2)["wall"],
+                     "mpirun_before", lambda: ex.run(portable, slice_64, 2, env=own)["wall"])
+            if not (a.quick or a.skip_16384):
+                r["n2_16384"].append(ex.run(portable, os.path.join(HERE, "slice_16384.toml"), 2))
+            if not a.quick:
+                for name in ("slice", "volume"):
+                    pair(f"full_{name}", lambda: ex.run(portable, refine_jobs[(name, 0)], 2, keep=f"{name}-0.h5"),
+                         f"coarse_{name}", lambda: ex.run(portable, refine_jobs[(name, 8)], 2, keep=f"{name}-8.h5"))
+                    full, coarse = r[f"full_{name}"][-1], r[f"coarse_{name}"][-1]
+                    r[f"refine_{name}"].append(coarse["rate"] / full["rate"])
+                    mismatch[name] = refinement_mismatch(full["output"], coarse["output"])
+                    remove_outputs(full["output"])
+                    remove_outputs(coarse["output"])
+
+    reps = range(a.repetitions)
+
+    def kernel_rate(k):
+        return [r["kernel"][i][k][0] for i in reps]
+
+    scalar = median(kernel_rate("scalar"))
     print("\n| run (4096^2 slice unless said) | points/s | vs scalar kernel | notes |")
     print("|---|---|---|---|")
-    for name, rate, note in rows:
-        print(f"| {name} | {rate:.3g} | {rate / scalar:.2f}x | {note} |")
-    n1, n2 = rows[2][1], rows[3][1]
-    print(f"\nvectorised / scalar kernel: {k['vectorised'][0] / scalar:.2f}x (target >= 2.5)")
-    print(f"explore -n 2 / explore -n 1: {n2 / n1:.2f}x (target >= 1.8)")
-    print(f"explore -n 1 / vectorised kernel: {n1 / k['vectorised'][0]:.2f} (target >= 0.85)")
-    print("\n| refine = 8 against the full grid (2 ranks) | speed-up | points that differ |")
-    print("|---|---|---|")
-    for name, speedup, mismatch in refined:
-        print(f"| {name} | {speedup:.2f}x | {100 * mismatch:.4f}% |")
-    if (16384, 2) in peaks:
-        ratio = peaks[(16384, 2)] / peaks[(4096, 2)]
-        print(f"peak memory per rank 16384^2 / 4096^2 (2 ranks): {ratio:.3f} (target < 1.10)")
+    for k in kernels:
+        ns = median([r["kernel"][i][k][1] for i in reps])
+        label = "scalar kernel, 1 core" if k == "scalar" else f"vectorised kernel {k}, 1 core"
+        note = f"{ns:.2f} ns per iteration of G"
+        if k == best:
+            note += "; the portable binary's choice here"
+        if k != "scalar":
+            note = re.search(r"\((.*)\)", r["kernel"][0][k][2]).group(1) + "; " + note
+        print(f"| {label} | {median(kernel_rate(k)):.3g} | {median(kernel_rate(k)) / scalar:.2f}x | {note} |")
+    if native:
+        rates = [x[0] for x in r["native_kernel"]]
+        print(f"| vectorised kernel, native build ({native.kernel_text}) | {median(rates):.3g} | "
+              f"{median(rates) / scalar:.2f}x | {median([x[1] for x in r['native_kernel']]):.2f} ns per iteration of G |")
+    for key, label in (("n1", "`explore -n 1`"), ("n2", "`explore -n 2`")):
+        rate = median([x["rate"] for x in r[key]])
+        print(f"| {label} | {rate:.3g} | {rate / scalar:.2f}x | {median([x['wall'] for x in r[key]]):.2f} s wall incl. "
+              f"start-up, peak {median([x['peak'] for x in r[key]]):.0f} MiB/rank |")
+    if r["n2_16384"]:
+        rate = median([x["rate"] for x in r["n2_16384"]])
+        print(f"| `explore -n 2`, 16384^2 | {rate:.3g} | {rate / scalar:.2f}x | "
+              f"{median([x['wall'] for x in r['n2_16384']]):.2f} s wall, "
+              f"peak {median([x['peak'] for x in r['n2_16384']]):.0f} MiB/rank |")
+
+    def ratio_line(text, values, fmt, target):
+        print(f"{text}: {fmt.format(median(values))} {spread(values, fmt)} ({target})")
+
+    print()
+    ratio_line("vectorised / scalar kernel", [kernel_rate(best)[i] / kernel_rate("scalar")[i] for i in reps], "{:.2f}x",
+               f"{best}; target >= 2.5")
+    ratio_line("explore -n 1 / vectorised kernel", [r["n1"][i]["rate"] / kernel_rate(best)[i] for i in reps], "{:.2f}",
+               "target >= 0.90")
+    ratio_line("explore -n 2 / explore -n 1", [r["n2"][i]["rate"] / r["n1"][i]["rate"] for i in reps], "{:.2f}x",
+               "target >= 1.85")
+    tiles = 8192 * 8192 // 1024
+    ratio_line("overhead per tile at 1024-point tiles (trivial 8192^2 grid, -n 1)",
+               [(r["tile1024"][i]["compute"] - r["tile262144"][i]["compute"]) / tiles * 1e6 for i in reps], "{:.1f} us",
+               f"compute phase {median([x['compute'] for x in r['tile1024']]):.2f} s with 1024-point tiles, "
+               f"{median([x['compute'] for x in r['tile262144']]):.2f} s with 262144; target <= 3 us")
+    calls = [c for c, _ in r["calls"]]
+    ratio_line("write calls to the result file per million points (8192^2 slice, -n 2)",
+               [c / (8192 * 8192 / 1e6) for c in calls], "{:.1f}",
+               f"{median(calls):.0f} calls, {median([b for _, b in r['calls']]) / 1e6:.0f} MB; target <= 3")
+    if native:
+        ratio_line("portable / native build, explore -n 1 points/s (8192^2 slice)",
+                   [r["p8192"][i]["rate"] / r["n8192"][i]["rate"] for i in reps], "{:.2f}",
+                   f"{median([x['compute'] for x in r['p8192']]):.2f} s against "
+                   f"{median([x['compute'] for x in r['n8192']]):.2f} s; target >= 0.95")
+        ratio_line("portable / native build, bare kernel (4096^2 slice)",
+                   [kernel_rate(best)[i] / r["native_kernel"][i][0] for i in reps], "{:.2f}",
+                   f"{best} against {native.kernel}")
+    for key, label in (("single", "singleton `superball explore`"), ("mpirun", "`mpirun -n 2 superball explore`")):
+        print(f"64^2 job, {label}: {median(r[key]):.2f} s wall {spread(r[key], '{:.2f}')}; with Open MPI's own "
+              f"start-up (OMPI_MCA_pml= OMPI_MCA_ess_singleton_isolated=0): {median(r[key + '_before']):.2f} s "
+              f"{spread(r[key + '_before'], '{:.2f}')} (target <= 0.20 s)")
+    if r["n2_16384"]:
+        ratio_line("peak memory per rank 16384^2 / 4096^2 (2 ranks)",
+                   [r["n2_16384"][i]["peak"] / r["n2"][i]["peak"] for i in reps], "{:.3f}", "target < 1.10")
+    if mismatch:
+        print("\n| refine = 8 against the full grid (2 ranks) | speed-up | points that differ |")
+        print("|---|---|---|")
+        for name, label in (("slice", "4096^2 slice"), ("volume", "256^3 volume, U in [-3, -0.05]")):
+            values = r[f"refine_{name}"]
+            print(f"| {label} | {median(values):.2f}x {spread(values, '{:.2f}')} | {100 * mismatch[name]:.4f}% |")
 
 
 if __name__ == "__main__":

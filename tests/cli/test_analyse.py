@@ -17,6 +17,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -24,6 +25,9 @@ import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+from superball_testing import tile_checksum  # noqa: E402
+
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 SOURCE_DIR = os.environ.get("SUPERBALL_SOURCE_DIR", os.path.join(HERE, os.pardir, os.pardir))
@@ -185,29 +189,42 @@ class Quickstart(unittest.TestCase):
         self.assertGreaterEqual(r["boundary"]["row_pairs"], self.report["boundary"]["row_pairs"])
 
     def test_missing_tiles_read_as_invalid(self):
-        partial = os.path.join(self.dir, "partial.h5")
-        shutil.copy(self.result, partial)
-        with h5py.File(partial, "r+") as f:
+        """The partial file of an interrupted run: points of tiles not done read as
+        invalid, and the report says how many tiles are missing."""
+        out = os.path.join(self.dir, "interrupted.h5")
+        r = subprocess.run([SUPERBALL, "explore", self.job, "-o", out, "-q", "--stop-after", "0"], capture_output=True,
+                           text=True, env=mpi_env(), timeout=300)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        partial = out + ".partial"
+        # Tiles done by the stopped run, and a few more copied from the complete result, each
+        # recorded with its checksum as the run records it (the readers check them).
+        with h5py.File(self.result, "r") as full, h5py.File(partial, "r+") as f:
             th, tw = (int(t) for t in f.attrs["tile_shape"])
             tiles_per_row = -(-N // tw)
             done = f["progress/tile_done"][...]
-            undone = [0, 3, len(done) - 1]
-            done[undone] = 0
+            sums = f["progress/tile_checksum"][...]
+            for t in (0, 3, len(done) - 1):
+                i0, j0 = (t // tiles_per_row) * th, (t % tiles_per_row) * tw
+                box = (slice(i0, i0 + th), slice(j0, j0 + tw))
+                f["wall_bounces"][box] = full["wall_bounces"][box]
+                f["outcome"][box] = full["outcome"][box]
+                sums[t] = tile_checksum(f["wall_bounces"], f["outcome"], t, (i0, j0))
+                done[t] = 1
+            f["progress/tile_checksum"][...] = sums
             f["progress/tile_done"][...] = done
-            f.attrs["complete"] = np.int64(0)
         points = 0
-        for t in undone:
+        for t in np.flatnonzero(done == 0):
             i0, j0 = (t // tiles_per_row) * th, (t % tiles_per_row) * tw
             points += (min(i0 + th, N) - i0) * (min(j0 + tw, N) - j0)
         r = analyse_json(partial)
-        self.assertEqual(r["tiles_missing"], len(undone))
+        self.assertEqual(r["tiles_missing"], int((done == 0).sum()))
         self.assertEqual(r["area"]["by_outcome"]["invalid"]["points"], points)
         self.assertEqual(r["area"]["valid"], N * N - points)
 
     def test_bad_input(self):
         for args, message in [
             ((os.path.join(self.dir, "nothing.h5"),), "no such file"),
-            ((self.job,), "is not a superball result"),
+            ((self.job,), "not a superball result"),
             ((self.result, "--slice", "U=0"), "3-D results only"),
             ((self.result, "--eps-max", "256"), "--eps-max"),
             ((self.result, "--box", "0"), "--box"),

@@ -1,7 +1,7 @@
 // Numerical edge cases of counting: starts at and extremely near the planes xi = 0 and
 // xi = 1, U -> 0-, huge |W|, subnormal numbers, no dissipation (e = alpha = 1), a smooth
 // ball (alpha = -1), counts above 65535, and arbitrary bit patterns. On every one the
-// scalar count() and the vectorised count_each_simd() agree, and every input gets an
+// scalar count() and every variant of the vectorised kernel this processor runs agree, and every input gets an
 // Outcome with its contract (invalid: 0 impacts; capped: exactly max_bounces; never more
 // than max_bounces).
 //
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "core/count.hpp"
-#include "core/count_simd.hpp"
+#include "core/kernels.hpp"
 
 namespace {
 
@@ -56,16 +56,17 @@ std::string describe(const CanonicalState<double>& c)
     return buf;
 }
 
-// count() and count_each_simd() on every start: identical, and each result keeps the
+// count() and a vectorised kernel on every start: identical, and each result keeps the
 // contract of an Outcome.
-void expect_kernels_agree(const std::vector<CanonicalState<double>>& s, const Model& model, std::uint32_t max)
+void expect_kernel_agrees(const KernelVariant& kernel, const std::vector<CanonicalState<double>>& s, const Model& model,
+                          std::uint32_t max)
 {
+    SCOPED_TRACE(describe(kernel));
     const ModelMatrices m = ModelMatrices::of(model);
-    Starts soa;
-    for (const auto& c : s) soa.push_back(c);
+    const Starts soa = Starts::of(s);
     std::vector<std::uint32_t> wb(s.size(), 0xdeadbeef);
     std::vector<std::uint8_t> oc(s.size(), 0xff);
-    count_each_simd(soa.view(), m, max, wb, oc);
+    kernel.count(soa.view(), m, max, wb, oc);
     int reported = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
         const BounceCount a = count(s[i], m, max);
@@ -78,6 +79,14 @@ void expect_kernels_agree(const std::vector<CanonicalState<double>>& s, const Mo
                           << ": count " << a.wall_bounces << "/" << name(a.outcome) << ", simd " << wb[i] << "/"
                           << int(oc[i]);
         }
+    }
+}
+
+// ... for every variant this processor runs (test_kernels.cpp says which it skips).
+void expect_kernels_agree(const std::vector<CanonicalState<double>>& s, const Model& model, std::uint32_t max)
+{
+    for (const KernelVariant& k : simd_kernels()) {
+        if (k.runs_here()) expect_kernel_agrees(k, s, model, max);
     }
 }
 

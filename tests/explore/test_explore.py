@@ -24,6 +24,11 @@ SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
 
+def text(value):
+    """An HDF5 text attribute as str (h5py gives fixed-length ones as bytes)."""
+    return value.decode("ascii") if isinstance(value, bytes) else str(value)
+
+
 def job_text(grid, model="e = 0.9\nalpha = 0.9", run="max_bounces = 1000"):
     return f"[model]\n{model}\n\n[grid]\n{grid}\n\n[run]\n{run}\n"
 
@@ -73,8 +78,10 @@ class Explore(unittest.TestCase):
             outputs.append(out)
             with h5py.File(out, "r") as f:
                 self.assertEqual(f.attrs["complete"], 1)
+                self.assertEqual(f.attrs["superball_file"], "result")
                 self.assertEqual(f.attrs["mpi_ranks"], ranks)
-                self.assertTrue(f["progress/tile_done"][()].all())
+                self.assertNotIn("progress", f)  # the journal stays with the partial file
+            self.assertFalse(os.path.exists(out + ".partial"))
         for out in outputs[1:]:
             self.assert_same_results(outputs[0], out)
 
@@ -87,7 +94,7 @@ class Explore(unittest.TestCase):
         names = ["invalid", "left", "missed", "capped"]
         rng = random.Random(7)
         with h5py.File(out, "r") as f:
-            xi, W = f["axes/xi"][()], f["axes/W"][()]
+            xi, W = f["xi"][()], f["W"][()]
         for _ in range(60):
             i, k = rng.randrange(len(xi)), rng.randrange(len(W))
             r = subprocess.run([SUPERBALL, "count", "--json", "--e-wall", "0.8", "--alpha-wall", "0.6", "--e-floor", "0.85",
@@ -97,23 +104,43 @@ class Explore(unittest.TestCase):
             self.assertEqual((got["wall_bounces"], got["outcome"]), (int(wb[i, k]), names[oc[i, k]]), (xi[i], W[k]))
 
     def test_layout(self):
+        """SPEC.md section 5 as issue 13 amends it: netCDF-4/CF conventions, compressed."""
         job = self.write_job(job_text(CANONICAL_2D))
         out = self.path("r.h5")
         self.explore(job, out, 2)
         with h5py.File(out, "r") as f:
-            self.assertEqual(f["wall_bounces"].dtype, np.uint16)
-            self.assertEqual(f["outcome"].dtype, np.uint8)
-            self.assertEqual(f["wall_bounces"].shape, (61, 47))
-            self.assertEqual(f["outcome"].shape, (61, 47))
-            self.assertEqual(f["wall_bounces"].chunks, f["outcome"].chunks)
-            self.assertEqual(sorted(f["axes"]), ["W", "xi"])
+            counts, outcome = f["wall_bounces"], f["outcome"]
+            self.assertEqual(counts.dtype, np.uint16)
+            self.assertEqual(outcome.dtype, np.uint8)
+            self.assertEqual(counts.shape, (61, 47))
+            self.assertEqual(outcome.shape, (61, 47))
+            self.assertEqual((counts.compression, counts.shuffle), ("gzip", True))
+            self.assertEqual((outcome.compression, outcome.shuffle), ("gzip", True))
+            # Coordinate variables at the root, attached as dimension scales.
+            self.assertEqual(sorted(f), ["U", "W", "outcome", "wall_bounces", "xi"])
+            for d in (counts, outcome):
+                self.assertEqual([dim[0].name for dim in d.dims], ["/xi", "/W"])
+                self.assertEqual(text(d.attrs["coordinates"]), "U")
+            self.assertTrue(h5py.h5ds.is_scale(f["xi"].id))
             # Cell centres, computed as SPEC.md section 4 says.
             expect = np.array([0.0 + (i + 0.5) * (1.0 - 0.0) / 61 for i in range(61)])
-            np.testing.assert_array_equal(f["axes/xi"][()], expect)
-            self.assertEqual(f["axes/W"].dtype, np.float64)
-            self.assertEqual(f["progress/tile_done"].dtype, np.uint8)
+            np.testing.assert_array_equal(f["xi"][()], expect)
+            self.assertEqual(f["W"].dtype, np.float64)
+            self.assertEqual(f["U"][()], -1.0)
+            for name in ("xi", "U", "W"):
+                self.assertEqual(text(f[name].attrs["units"]), "1")
+                self.assertIn(name, text(f[name].attrs["long_name"]))
+            self.assertEqual(text(counts.attrs["units"]), "1")
+            self.assertTrue(text(counts.attrs["long_name"]))
+            self.assertEqual(list(outcome.attrs["flag_values"]), [0, 1, 2, 3])
+            self.assertEqual(outcome.attrs["flag_values"].dtype, np.uint8)
+            self.assertEqual(text(outcome.attrs["flag_meanings"]), "invalid left missed capped")
+            # netCDF text (fixed-length ASCII), not NC_STRING, which some netCDF tools drop.
+            self.assertFalse(h5py.check_string_dtype(outcome.attrs.get_id("flag_meanings").dtype).length is None)
             a = f.attrs
-            self.assertEqual(a["coordinates"], "canonical")
+            self.assertEqual(text(a["Conventions"]), "CF-1.8")
+            self.assertEqual(a["coordinate_system"], "canonical")
+            self.assertNotIn("coordinates", a)  # CF's keyword for auxiliary coordinates: xarray would take it
             self.assertEqual(list(a["axis_names"]), ["xi", "W"])
             for key in ["e_wall", "alpha_wall", "e_floor", "alpha_floor"]:
                 self.assertEqual(a[key], 0.9)
@@ -125,17 +152,58 @@ class Explore(unittest.TestCase):
             self.assertEqual(a["complete"], 1)
             self.assertTrue(a["software_version"])
             self.assertNotIn("g", a)  # canonical grids have no g/radius
-            outcomes = set(np.unique(f["outcome"][()]))
+            outcomes = set(np.unique(outcome[()]))
             self.assertTrue(outcomes <= {1, 2, 3})
+        # The sidecar: a 3-D mesh one sample thick at U = -1.
         xmf = ET.parse(self.path("r.xmf")).getroot()
         topology = xmf.find(".//Topology")
-        self.assertEqual(topology.get("TopologyType"), "2DRectMesh")
-        self.assertEqual(topology.get("Dimensions"), "61 47")
+        self.assertEqual(topology.get("TopologyType"), "3DRectMesh")
+        self.assertEqual(topology.get("Dimensions"), "61 1 47")
         h5dump = shutil.which("h5dump")
         if h5dump:
             r = subprocess.run([h5dump, "-H", out], capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
             self.assertIn('DATASET "wall_bounces"', r.stdout)
+
+    def test_large_grids_get_large_chunks(self):
+        """Chunks of at least 256 KiB of counts on large grids (for readers and the
+        compressor), whatever the tiles of the run."""
+        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 1024 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 768 }',
+                                      run="max_bounces = 1000\ntile_points = 1024"))
+        out = self.path("big.h5")
+        self.explore(job, out, 2)
+        with h5py.File(out, "r") as f:
+            chunks = f["wall_bounces"].chunks
+            self.assertGreaterEqual(np.prod(chunks) * 2, 256 * 1024, chunks)
+        self.assertLess(os.path.getsize(out), 0.02 * 1024 * 768 * 3)
+
+    def test_ten_billion_points_are_not_filled(self):
+        """Creating the file of a 10^10-point job allocates 30 GB of chunks but writes none of
+        them: the data are never filled, only the journal (9 bytes a tile) and metadata."""
+        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 100000 }\nU = -1.0\n'
+                                      'W = { min = -3.0, max = 3.0, n = 100000 }'))
+        out = self.path("huge.h5")
+        start = time.time()
+        r = self.explore(job, out, 1, ["--stop-after", "0"], expect=1)
+        self.assertIn("--resume", r.stderr)
+        st = os.stat(out + ".partial")
+        self.assertGreaterEqual(st.st_size, 3 * 10**10)        # every chunk allocated...
+        self.assertLess(st.st_blocks * 512, 64 * 2**20, st)     # ...and none written
+        self.assertLess(time.time() - start, 60)
+        # Reading it reads the tiles done, not 30 GB of nothing.
+        info = subprocess.run([SUPERBALL, "info", out], capture_output=True, text=True, timeout=30)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertRegex(info.stdout, r"complete: +no \(0 of \d+ tiles done\)")
+
+    def test_uncompressed(self):
+        job = self.write_job(job_text(CANONICAL_2D, run="max_bounces = 1000\ncompression = 0"))
+        out = self.path("raw.h5")
+        self.explore(job, out, 2)
+        with h5py.File(out, "r") as f:
+            self.assertIsNone(f["wall_bounces"].compression)
+        reference = self.path("compressed.h5")
+        self.explore(self.write_job(job_text(CANONICAL_2D), "c.toml"), reference, 1)
+        self.assert_same_results(out, reference)
 
     def test_three_dimensional_grid(self):
         grid = ('xi = { min = 0.0, max = 1.0, n = 13 }\nU = { min = -2.0, max = -0.1, n = 9 }\n'
@@ -158,8 +226,9 @@ class Explore(unittest.TestCase):
         self.explore(job, out, 2)
         with h5py.File(out, "r") as f:
             wb, oc = f["wall_bounces"][()], f["outcome"][()]
-            u = f["axes/u"][()]
-            self.assertEqual(f.attrs["coordinates"], "physical")
+            u = f["u"][()]
+            self.assertEqual(f.attrs["coordinate_system"], "physical")
+            self.assertEqual([text(f[n].attrs["units"]) for n in ("x", "u", "v", "omega")], ["m", "m/s", "m/s", "rad/s"])
             self.assertEqual(f.attrs["g"], 9.81)
             self.assertEqual(f.attrs["radius"], 0.025)
             self.assertEqual(f.attrs["fixed_v"], 2.0)
@@ -172,7 +241,7 @@ class Explore(unittest.TestCase):
         # spot-check a grid point against `superball count` with the physical flags.
         i, k = 3, int(np.argmin(abs(u + 2)))
         with h5py.File(out, "r") as f:
-            x = f["axes/x"][i]
+            x = f["x"][i]
         r = subprocess.run([SUPERBALL, "count", "--json", "--e", "0.9", "--alpha", "0.9", "--x", repr(float(x)), "--u",
                             repr(float(u[k])), "--v", "2", "--omega", "-200"], capture_output=True, text=True, check=True)
         self.assertEqual(json.loads(r.stdout)["wall_bounces"], int(wb[i, k]))
@@ -185,7 +254,9 @@ class Explore(unittest.TestCase):
         with h5py.File(out, "r") as f:
             self.assertEqual(f["wall_bounces"].shape, (100,))
             self.assertEqual(f["wall_bounces"].dtype, np.uint32)  # max_bounces > 65535
-        self.assertFalse(os.path.exists(self.path("line.xmf")))
+        # A line: the mesh is 3-D, one sample thick along U and W.
+        topology = ET.parse(self.path("line.xmf")).getroot().find(".//Topology")
+        self.assertEqual(topology.get("Dimensions"), "100 1 1")
 
     def test_swept_coefficient(self):
         """alpha as a range axis (before the coordinates): each slice equals a run at that
@@ -202,7 +273,8 @@ class Explore(unittest.TestCase):
             self.assertEqual(f.attrs["alpha_floor"], "axis:alpha")
             self.assertEqual(f.attrs["e_wall"], 0.9)
             self.assertEqual(f.attrs["e_floor"], 0.8)
-            alphas = f["axes/alpha"][()]
+            alphas = f["alpha"][()]
+            self.assertEqual([dim[0].name for dim in f["wall_bounces"].dims], ["/alpha", "/xi", "/W"])
             wb, oc = f["wall_bounces"][()], f["outcome"][()]
         np.testing.assert_array_equal(alphas, [0.5 + (i + 0.5) * 0.5 / 5 for i in range(5)])
         # The sweep plots: a 2-D slice at one alpha.
@@ -223,7 +295,7 @@ class Explore(unittest.TestCase):
                              "ea.toml")
         self.explore(job, self.path("ea.h5"), 2)
         with h5py.File(self.path("ea.h5"), "r") as f:
-            e, a, w = f["axes/e"][()], f["axes/alpha"][()], f["wall_bounces"][()]
+            e, a, w = f["e"][()], f["alpha"][()], f["wall_bounces"][()]
         for i, k in [(0, 0), (3, 8), (6, 4)]:
             r = subprocess.run([SUPERBALL, "count", "--json", "--e", repr(float(e[i])), "--alpha", repr(float(a[k])),
                                 "--xi", "0.05", "--U", "-1", "--W", "-2"], capture_output=True, text=True, check=True)
@@ -262,7 +334,7 @@ class Explore(unittest.TestCase):
         self.assertLess(mismatch, 0.01)
         # W > -0.8 is all one bounce, left: refinement must reproduce it exactly.
         with h5py.File(full, "r") as f:
-            calm = f["axes/W"][()] > -0.8
+            calm = f["W"][()] > -0.8
             self.assertEqual(f.attrs["refine"], 0)
         np.testing.assert_array_equal(wr[:, calm], wf[:, calm])
         with h5py.File(one, "r") as f:
@@ -287,23 +359,24 @@ class Explore(unittest.TestCase):
         self.assertIn("different job", r.stderr)
 
     def test_resume_after_sigkill(self):
-        """A run killed with SIGKILL mid-way, then --resume, equals an uninterrupted run."""
+        """A run killed with SIGKILL mid-way, then --resume, equals an uninterrupted run; the
+        interrupted run never sits under the result's name."""
         # Sized by the speed of the binary under test (a release build or a sanitized
         # one) to last about 2.5 s on two ranks, long enough to be killed part-way.
         job = self.write_job(killable_job(wall_impacts_per_second(SUPERBALL, self.dir), 2.5))
         out = self.path("killed.h5")
+        partial = out + ".partial"
         proc = subprocess.Popen([MPIEXEC, "-n", "2", "--oversubscribe", SUPERBALL, "explore", job, "-o", out, "-q"],
                                 env=mpi_env(), start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        reader_env = dict(os.environ, HDF5_USE_FILE_LOCKING="FALSE")
         done, total = 0, 1
         deadline = time.time() + 120
         while time.time() < deadline and proc.poll() is None:
             time.sleep(0.05)
-            if not os.path.exists(out):
+            if not os.path.exists(partial):
                 continue
             r = subprocess.run([sys.executable, "-c",
                                 "import h5py,sys; d=h5py.File(sys.argv[1],'r')['progress/tile_done'][()]; print(d.sum(), d.size)",
-                                out], capture_output=True, text=True, env=reader_env)
+                                partial], capture_output=True, text=True)
             if r.returncode == 0:
                 done, total = map(int, r.stdout.split())
                 if done >= total // 5:
@@ -317,13 +390,17 @@ class Explore(unittest.TestCase):
         proc.wait()
         proc.stderr.close()
         self.assertGreater(done, 0)
-        with h5py.File(out, "r") as f:
+        self.assertFalse(os.path.exists(out))
+        self.assertFalse(os.path.exists(self.path("killed.xmf")))
+        with h5py.File(partial, "r") as f:
             self.assertEqual(f.attrs["complete"], 0)
+            self.assertEqual(f.attrs["superball_file"], "partial")
             marked = int(f["progress/tile_done"][()].sum())
             self.assertLess(marked, f["progress/tile_done"].size)
-        r = self.explore(job, out, 1, expect=2)  # an interrupted file is not overwritten either
+        r = self.explore(job, out, 1, expect=2)  # an interrupted run is not overwritten either
         self.assertIn("--resume", r.stderr)
         self.explore(job, out, 2, ["--resume"])
+        self.assertFalse(os.path.exists(partial))
         reference = self.path("straight.h5")
         self.explore(job, reference, 2)
         self.assert_same_results(out, reference)

@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer target for the job-file parser and validator with clang
-# (AddressSanitizer + UndefinedBehaviorSanitizer, every report fatal) and fuzzes it for
-# a bounded time from the seed corpus (tests/fuzz/corpus and every job file in jobs/).
+# Builds the two libFuzzer targets with clang (AddressSanitizer + UndefinedBehaviorSanitizer,
+# every report fatal) and fuzzes each for half the time given, from its seed corpus:
 #
-#   tests/fuzz/run.sh [SECONDS]          default 60; 0 only builds and replays the seeds
+#   fuzz_job     the job-file parser and validator (seeds: tests/fuzz/corpus and every job
+#                file in jobs/)
+#   fuzz_result  the file validator, ResultReader: inputs are edits applied to small valid
+#                result and partial files (fuzz_result.cpp; seeds: tests/fuzz/result_corpus)
+#
+#   tests/fuzz/run.sh [SECONDS]          default 60 in all; 0 only builds and replays the seeds
 #
 # Exit status non-zero on a finding; the reproducer is left in build/fuzz/ (replay it with
-# build/fuzz/fuzz_job FILE). Needs clang and libclang-rt-14-dev (.ci/install-deps --dev).
+# build/fuzz/fuzz_job FILE or build/fuzz/fuzz_result FILE). Needs clang and
+# libclang-rt-14-dev (.ci/install-deps --dev).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 seconds=${1:-60}
@@ -17,7 +22,12 @@ command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found: run .ci/install-de
 
 # What parse_job needs: the job layer and the model input checks. toml++ is compiled
 # header-only so that the TOML parser is instrumented and fuzzed too.
-sources=(tests/fuzz/fuzz_job.cpp src/job/job.cpp src/job/job_parse.cpp src/job/spelling.cpp src/core/input.cpp)
+job_sources=(src/job/job.cpp src/job/job_parse.cpp src/job/spelling.cpp src/core/input.cpp)
+# What ResultReader needs, and the writers of its templates. HDF5 itself is Debian's, not
+# instrumented: coverage guides the fuzzer through our validation, not HDF5's parser.
+result_sources=(src/io/result_reader.cpp src/io/hdf5.cpp src/io/layout.cpp src/io/partial_file.cpp src/io/posix_file.cpp
+                src/io/result_metadata.cpp src/mpi/mpi.cpp src/job/grid.cpp src/job/tiles.cpp src/core/count.cpp
+                src/core/boundary_planes.cpp src/core/dynamics.cpp)
 # toml_assert.hpp: see there (toml++ 3.3.0 preconditions on the current character are
 # passed over, as in release). -fno-sanitize=unreachable: toml++ 3.3.0's
 # is_non_ascii_horizontal_whitespace() reaches TOML_UNREACHABLE for some non-ASCII
@@ -28,28 +38,61 @@ sources=(tests/fuzz/fuzz_job.cpp src/job/job.cpp src/job/job_parse.cpp src/job/s
 flags=(-std=c++20 -g -O1 -fno-omit-frame-pointer -ffp-contract=off -DTOML_HEADER_ONLY=1 -I"$root/src"
        -include "$root/tests/fuzz/toml_assert.hpp"
        -fsanitize=fuzzer,address,undefined -fno-sanitize=unreachable -fno-sanitize-recover=all)
-stamp=$out/fuzz_job.stamp
-if [[ ! -x $out/fuzz_job ]] || [[ -n $(cd "$root" && find "${sources[@]}" src/job/job.hpp src/job/spelling.hpp src/core/input.hpp \
-      src/core/model.hpp src/core/state.hpp tests/fuzz/toml_assert.hpp tests/fuzz/run.sh -newer "$stamp" 2>/dev/null) ]]; then
-  echo "fuzz: building $out/fuzz_job" >&2
-  (cd "$root" && "$cxx" "${flags[@]}" "${sources[@]}" -o "$out/fuzz_job.tmp")
-  mv "$out/fuzz_job.tmp" "$out/fuzz_job"
-  touch "$stamp"
-fi
 
-# libFuzzer writes new inputs into the first corpus directory: a scratch copy, so the
+# The version header CMake generates, for the result writers.
+version=$(sed -n 's/^project(superball VERSION \([0-9.]*\).*/\1/p' "$root/CMakeLists.txt")
+mkdir -p "$out/generated/superball"
+sed "s/@PROJECT_VERSION@/$version/" "$root/src/version.hpp.in" >"$out/generated/superball/version.hpp.tmp"
+cmp -s "$out/generated/superball/version.hpp.tmp" "$out/generated/superball/version.hpp" ||
+  mv "$out/generated/superball/version.hpp.tmp" "$out/generated/superball/version.hpp"
+rm -f "$out/generated/superball/version.hpp.tmp"
+# shellcheck disable=SC2207
+hdf5=($(pkg-config --cflags hdf5-openmpi libxxhash) -I/usr/include/eigen3 -I"$out/generated")
+hdf5_libs=($(pkg-config --libs hdf5-openmpi libxxhash) -lhdf5_hl -lfmt $(mpicxx --showme:link))
+
+# build NAME DEPENDENCIES -- SOURCES... -- EXTRA FLAGS...: rebuilds build/fuzz/NAME when a
+# source, a file of DEPENDENCIES (a find expression's paths) or this script is newer than
+# the last build.
+build() {
+  local name=$1 deps=$2; shift 2
+  shift  # --
+  local sources=() extra=()
+  while (($# > 0)) && [[ $1 != -- ]]; do sources+=("$1"); shift; done
+  (($# > 0)) && shift && extra=("$@")
+  local stamp=$out/$name.stamp
+  # shellcheck disable=SC2086
+  if [[ ! -x $out/$name ]] || [[ -n $(cd "$root" && find "${sources[@]}" $deps tests/fuzz/toml_assert.hpp tests/fuzz/run.sh \
+                                        -newer "$stamp" 2>/dev/null) ]]; then
+    echo "fuzz: building $out/$name" >&2
+    (cd "$root" && "$cxx" "${flags[@]}" "${sources[@]}" "${extra[@]}" -o "$out/$name.tmp")
+    mv "$out/$name.tmp" "$out/$name"
+    touch "$stamp"
+  fi
+}
+build fuzz_job "src/job/job.hpp src/job/spelling.hpp src/core/input.hpp src/core/model.hpp src/core/state.hpp" -- \
+  tests/fuzz/fuzz_job.cpp "${job_sources[@]}"
+build fuzz_result "src" -- tests/fuzz/fuzz_result.cpp "${result_sources[@]}" "${job_sources[@]}" -- "${hdf5[@]}" "${hdf5_libs[@]}"
+
+# libFuzzer writes new inputs into the first corpus directory: scratch copies, so the
 # checked-in seeds stay as they are.
-work=$out/corpus
-rm -rf "$work"
-mkdir -p "$work"
-cp "$root"/tests/fuzz/corpus/* "$work"/
-find "$root/jobs" -name '*.toml' -exec cp {} "$work"/ \;
+rm -rf "$out/corpus" "$out/result_corpus"
+mkdir -p "$out/corpus" "$out/result_corpus"
+cp "$root"/tests/fuzz/corpus/* "$out/corpus"/
+find "$root/jobs" -name '*.toml' -exec cp {} "$out/corpus"/ \;
+cp "$root"/tests/fuzz/result_corpus/* "$out/result_corpus"/
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+# The result target's templates are parallel HDF5's files, written without MPI started.
+if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 if ((seconds == 0)); then
-  exec "$out/fuzz_job" -runs=0 "$work"
+  "$out/fuzz_job" -runs=0 "$out/corpus"
+  exec "$out/fuzz_result" -runs=0 "$out/result_corpus"
 fi
-echo "fuzz: fuzzing parse_job for ${seconds} s" >&2
-exec "$out/fuzz_job" "$work" -dict="$root/tests/fuzz/toml.dict" -max_total_time="$seconds" -max_len=8192 \
+half=$(((seconds + 1) / 2))
+echo "fuzz: fuzzing parse_job for ${half} s" >&2
+"$out/fuzz_job" "$out/corpus" -dict="$root/tests/fuzz/toml.dict" -max_total_time="$half" -max_len=8192 \
+  -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" -close_fd_mask=1
+echo "fuzz: fuzzing ResultReader for $((seconds - half)) s" >&2
+exec "$out/fuzz_result" "$out/result_corpus" -max_total_time="$((seconds - half))" -max_len=128 -len_control=0 \
   -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" -close_fd_mask=1

@@ -18,7 +18,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import mpi_env, superball_binary  # noqa: E402
+from superball_testing import interrupted_run, mpi_env, superball_binary  # noqa: E402
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
@@ -37,7 +37,8 @@ tile_points = 400
 """
 
 # About 3 MB of results in 1024-point tiles: a 1 MiB file system fills a third of the way.
-BIG_JOB = SMALL_JOB.replace("n = 200", "n = 1000").replace("tile_points = 400", "tile_points = 1024").replace(
+# The journal every 10 ms, so that tiles are recorded done before the disk fills.
+BIG_JOB = SMALL_JOB.replace("n = 200", "n = 1000").replace("tile_points = 400", "tile_points = 1024\ncheckpoint_seconds = 0.01").replace(
     "max_bounces = 1000", "max_bounces = 100")
 
 
@@ -115,8 +116,8 @@ class Faults(unittest.TestCase):
     def test_directory_where_the_file_is_expected(self):
         target = self.path("a-directory.h5")
         os.makedirs(target, exist_ok=True)
-        self.assert_refused(target, "not a readable superball result")
-        self.assert_refused(target, "Is a directory", "--overwrite")
+        self.assert_refused(target, "is a directory")
+        self.assert_refused(target, "is a directory", "--overwrite")
 
     def test_path_under_proc(self):
         self.assert_refused("/proc/superball-test.h5", "cannot write the result")
@@ -143,16 +144,18 @@ class Faults(unittest.TestCase):
         # Before the fix the rank that failed to write waited for ever in the collective
         # close of the file while the other waited for its next tile: the timeout.
         r = self.explore(job, out, expect=1, timeout=120)
-        self.assertIn(f"writing tile", r.stderr)
-        self.assertIn(out, r.stderr)
+        self.assertIn("writing tiles", r.stderr)
+        self.assertIn(out + ".partial", r.stderr)
         self.assertIn("full", r.stderr)
         self.assertIn("--resume", r.stderr)
-        with h5py.File(out, "r") as f:
+        self.assertNotIn("Segmentation fault", r.stderr)
+        self.assertFalse(os.path.exists(out))  # no result, complete or not
+        with h5py.File(out + ".partial", "r") as f:
             self.assertEqual(f.attrs["complete"], 0)
             done = f["progress/tile_done"][()]
-            self.assertGreater(done.sum(), 0)
             self.assertLess(done.sum(), done.size)
-        # Room again: the resume completes it, identical to a run that never failed.
+        # Room again: the resume checks the tiles recorded done and completes the run,
+        # identical to a run that never failed.
         subprocess.run(["mount", "-o", "remount,size=16M", mnt], check=True)
         self.explore(job, out, "--resume", expect=0)
         reference = self.path("big-reference.h5")
@@ -174,7 +177,8 @@ class Faults(unittest.TestCase):
             pass  # full
         out = os.path.join(mnt, "out.h5")
         r = self.explore(self.small, out, expect=1, timeout=120)
-        self.assertIn("creating " + out, r.stderr)
+        self.assertIn("creating " + out + ".partial", r.stderr)
+        self.assertEqual(r.stderr.count("superball explore"), 1, r.stderr)  # one message, not one per rank
         self.assertIn("full", r.stderr)
         if os.path.exists(out):  # whatever is left is not a result, let alone a complete one
             self.assertEqual(self.explore(self.small, out, "--resume").returncode, 2)
@@ -182,16 +186,14 @@ class Faults(unittest.TestCase):
     # --- Damaged results and --resume -------------------------------------------------------
 
     def interrupted_copy(self, name):
-        """The reference result as an interrupted run leaves it: every other tile done."""
-        p = self.path(name)
-        shutil.copy(self.reference, p)
-        with h5py.File(p, "r+") as f:
-            done = f["progress/tile_done"]
-            flags = done[()]
-            flags[1::2] = 0
-            done[...] = flags
-            f.attrs["complete"] = 0
-        return p
+        """The partial file an interrupted run of the small job leaves, every other tile done
+        (taken from the reference result); returns the output path whose partial file it is."""
+        out = self.path(name)
+        for p in (out, out + ".partial"):
+            if os.path.exists(p):
+                os.remove(p)
+        interrupted_run(self.binary, self.small, out, self.reference, lambda t: t % 2 == 0)
+        return out
 
     def assert_resumed_identical(self, p):
         with h5py.File(p, "r") as f, h5py.File(self.reference, "r") as g:
@@ -200,64 +202,71 @@ class Faults(unittest.TestCase):
             np.testing.assert_array_equal(f["outcome"][()], g["outcome"][()])
 
     def test_resume_of_an_undamaged_interrupted_file(self):
-        p = self.interrupted_copy("intact.h5")
-        self.explore(self.small, p, "--resume", expect=0)
-        self.assert_resumed_identical(p)
+        out = self.interrupted_copy("intact.h5")
+        self.explore(self.small, out, "--resume", expect=0)
+        self.assert_resumed_identical(out)
+        self.assertFalse(os.path.exists(out + ".partial"))
 
     def test_resume_refuses_a_truncated_file(self):
         for fraction in (0.5, 0.99):
             with self.subTest(fraction=fraction):
-                p = self.interrupted_copy("truncated.h5")
-                os.truncate(p, int(os.path.getsize(p) * fraction))
-                self.assert_refused(p, "truncated file", "--resume")
+                out = self.interrupted_copy("truncated.h5")
+                os.truncate(out + ".partial", int(os.path.getsize(out + ".partial") * fraction))
+                self.assert_refused(out, "truncated", "--resume")
 
     def test_resume_refuses_a_damaged_done_tile(self):
-        p = self.interrupted_copy("damaged.h5")
-        with h5py.File(p, "r") as f:
+        out = self.interrupted_copy("damaged.h5")
+        partial = out + ".partial"
+        with h5py.File(partial, "r") as f:
             offset = f["wall_bounces"].id.get_chunk_info(0).byte_offset  # tile 0 is done
-        with open(p, "r+b") as f:
+        with open(partial, "r+b") as f:
             f.seek(offset + 10)
             f.write(b"\x07\x00")
-        r = self.assert_refused(p, "damaged", "--resume")
+        r = self.assert_refused(out, "damaged", "--resume")
         self.assertIn("tile 0", r.stderr)
-        # The same file marked complete is refused too, rather than called complete.
-        with h5py.File(p, "r+") as f:
-            f.attrs["complete"] = 1
+        # The same file with every tile recorded done is refused too, rather than finished.
+        with h5py.File(partial, "r+") as f:
             f["progress/tile_done"][...] = 1
-        self.assert_refused(p, "damaged", "--resume")
+        self.assert_refused(out, "damaged", "--resume")
+        # A partial file that claims to be complete contradicts itself: refused as damaged.
+        with h5py.File(partial, "r+") as f:
+            f.attrs["complete"] = 1
+        self.assert_refused(out, "contradicts", "--resume")
         # --overwrite starts again.
-        self.explore(self.small, p, "--overwrite", expect=0)
-        self.assert_resumed_identical(p)
+        self.explore(self.small, out, "--overwrite", expect=0)
+        self.assert_resumed_identical(out)
 
     def test_resume_refuses_a_tile_marked_done_without_its_data(self):
-        p = self.interrupted_copy("forged.h5")
-        with h5py.File(p, "r+") as f:
+        out = self.interrupted_copy("forged.h5")
+        with h5py.File(out + ".partial", "r+") as f:
             # As if the done flag of tile 1 had reached the disk but not its data.
             f["progress/tile_done"][1] = 1
             f["progress/tile_checksum"][1] = 0
-        self.assert_refused(p, "damaged", "--resume")
+        self.assert_refused(out, "damaged", "--resume")
 
     def test_resume_never_mixes_in_overwritten_bytes(self):
-        """Bytes overwritten anywhere in the file: the resume is refused with the file left
-        as it is, or (the bytes were in a tile not yet done) it completes the file
-        identical to an uninterrupted run. Never a mixture."""
-        size = os.path.getsize(self.reference)
+        """Bytes overwritten anywhere in the partial file: the resume is refused with the
+        file left as it is, or (the bytes were in a tile not yet done, or in space no
+        object uses) it completes the run identical to an uninterrupted one. Never a mixture."""
         refused = 0
         for fraction in np.linspace(0.01, 0.99, 9):
-            p = self.interrupted_copy("overwritten.h5")
-            with open(p, "r+b") as f:
+            out = self.interrupted_copy("overwritten.h5")
+            partial = out + ".partial"
+            size = os.path.getsize(partial)
+            with open(partial, "r+b") as f:
                 f.seek(int(size * fraction))
                 f.write(bytes((37 * i + 11) % 256 for i in range(16)))
-            before = read_bytes(p)
-            r = self.explore(self.small, p, "--resume")
+            before = read_bytes(partial)
+            r = self.explore(self.small, out, "--resume")
             with self.subTest(fraction=float(fraction)):
                 if r.returncode == 0:
-                    self.assert_resumed_identical(p)
+                    self.assert_resumed_identical(out)
                 else:
                     refused += 1
                     self.assertEqual(r.returncode, 2, r.stderr)
                     self.assertNotIn("MPI_ABORT", r.stderr)
-                    self.assertEqual(read_bytes(p), before)
+                    self.assertEqual(read_bytes(partial), before)
+                    self.assertFalse(os.path.exists(out))
         self.assertGreater(refused, 0)  # some of them hit done tiles
 
     # --- Inputs that once went wrong --------------------------------------------------------

@@ -4,6 +4,9 @@ them: every time the job ends, the file left behind is consistent (complete = 0,
 tile marked done holds exactly the data of an uninterrupted run) and `--resume` completes
 it into a file identical to an uninterrupted run.
 
+While a run goes on, its tiles and the journal of those done are in OUTPUT.partial; the
+result takes its name OUTPUT only once complete.
+
 (a) SIGTERM to every rank (what Slurm does at a time limit): clean stop, non-zero status,
     stderr says how to resume.
 (b) SIGINT to rank 0 only (Ctrl-C on one process): rank 0 stops handing out tiles, the
@@ -28,14 +31,12 @@ import tempfile
 import time
 import unittest
 
-# The writer holds the file open (MPI-IO, no lock); this process only peeks at it.
-os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
-
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import capped_job, descendants, killable_job, mpi_env, superball_binary, wall_impacts_per_second  # noqa: E402
+from superball_testing import (capped_job, descendants, killable_job, mpi_env, superball_binary,  # noqa: E402
+                               tile_boxes, wall_impacts_per_second)
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
@@ -65,18 +66,6 @@ def alive(pid):
             return f.read().rsplit(")", 1)[1].split()[0] != "Z"
     except OSError:
         return False
-
-
-def tile_boxes(f):
-    """Tile t -> slices of the datasets (row-major over the tiles, as src/explore/tiles.cpp)."""
-    shape = f["wall_bounces"].shape
-    tile = [int(x) for x in f.attrs["tile_shape"]]
-    per_axis = [-(-s // t) for s, t in zip(shape, tile)]
-    boxes = []
-    for t in range(int(np.prod(per_axis))):
-        index = np.unravel_index(t, per_axis)
-        boxes.append(tuple(slice(i * t, min((i + 1) * t, s)) for i, t, s in zip(index, tile, shape)))
-    return boxes
 
 
 class Signals(unittest.TestCase):
@@ -145,12 +134,12 @@ class Signals(unittest.TestCase):
         self.fail("the ranks did not start")
 
     def wait_for_tiles(self, proc, output, fraction):
-        """Until at least `fraction` of the tiles (and at least one) are marked done."""
+        """Until at least `fraction` of the tiles (and at least one) are recorded done."""
         deadline = time.time() + 300
         while time.time() < deadline:
             self.assertIsNone(proc.poll(), "the run ended before it could be interrupted: make the grid larger")
             try:
-                with h5py.File(output, "r") as f:
+                with h5py.File(output + ".partial", "r") as f:
                     done = f["progress/tile_done"][()]
                 if done.sum() >= max(1, fraction * done.size):
                     return int(done.sum())
@@ -170,26 +159,28 @@ class Signals(unittest.TestCase):
             return status, f.read()
 
     def assert_consistent_and_resumable(self, job, output):
-        """complete = 0; each tile marked done holds the reference's data; --resume then
-        completes the file, identical to the reference."""
+        """No result yet; the partial file: complete = 0, each tile recorded done holds the
+        reference's data; --resume then completes the run, identical to the reference."""
         wb_ref, oc_ref = self.reference(job)
-        with h5py.File(output, "r") as f:
+        self.assertFalse(os.path.exists(output), "an interrupted run under the result's name")
+        with h5py.File(output + ".partial", "r") as f:
             self.assertEqual(f.attrs["complete"], 0)
             done = f["progress/tile_done"][()]
             self.assertTrue(set(np.unique(done)) <= {0, 1})
             self.assertLess(int(done.sum()), done.size, "every tile done: nothing was interrupted")
             wb, oc = f["wall_bounces"][()], f["outcome"][()]
-            for t, box in enumerate(tile_boxes(f)):
+            tile_shape = [int(n) for n in f.attrs["tile_shape"]]
+            for t, box in enumerate(tile_boxes(wb.shape, tile_shape)):
                 if done[t]:
                     np.testing.assert_array_equal(wb[box], wb_ref[box], f"tile {t}")
                     np.testing.assert_array_equal(oc[box], oc_ref[box], f"tile {t}")
-        # Without --resume an interrupted file is left alone.
+        # Without --resume an interrupted run is left alone.
         r = self.explore(job, output, expect=2)
         self.assertIn("--resume", r.stderr)
         self.explore(job, output, "--resume")
+        self.assertFalse(os.path.exists(output + ".partial"))
         with h5py.File(output, "r") as f:
             self.assertEqual(f.attrs["complete"], 1)
-            self.assertTrue(f["progress/tile_done"][()].all())
             np.testing.assert_array_equal(f["wall_bounces"][()], wb_ref)
             np.testing.assert_array_equal(f["outcome"][()], oc_ref)
 

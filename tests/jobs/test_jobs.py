@@ -138,9 +138,10 @@ class QuickJobsRun(unittest.TestCase):
                     with h5py.File(out, "r") as f:
                         self.assertEqual(int(f.attrs["complete"]), 1)
                         self.assertEqual(int(f.attrs["mpi_ranks"]), 2)
-                        self.assertTrue(np.all(f["progress/tile_done"][...] == 1))
+                        self.assertEqual(f.attrs["superball_file"], "result")
                         counts = f["wall_bounces"][...]
                         self.assertEqual(f["outcome"].shape, counts.shape)
+                    self.assertFalse(os.path.exists(out + ".partial"))
                     # A figure worth drawing: the ranges hold several wall-bounce counts.
                     self.assertGreaterEqual(len(np.unique(counts)), 4, f"{name}: counts {np.unique(counts)}")
                     print(f"  {name}: {seconds:.2f} s", file=sys.stderr)
@@ -154,6 +155,25 @@ class Scripts(unittest.TestCase):
         r = self.run_script(os.path.join(JOBS, "local.sh"), "--help")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("local.sh JOB.toml", r.stdout)
+
+    def test_bifurcation_sh_runs_continuation_and_draws(self):
+        r = self.run_script(os.path.join(JOBS, "bifurcation.sh"), "--help")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("bifurcation.sh NAME OPTIONS", r.stdout)
+        self.assertEqual(self.run_script(os.path.join(JOBS, "bifurcation.sh"), "only-a-name").returncode, 2)
+        with tempfile.TemporaryDirectory() as results:
+            env = {**mpi_env(), "SUPERBALL": superball_binary(), "SUPERBALL_RESULTS": results, "SUPERBALL_RANKS": "2",
+                   "OMPI_MCA_rmaps_base_oversubscribe": "1"}
+            r = subprocess.run([os.path.join(JOBS, "bifurcation.sh"), "corner", "--e", "0.9", "--alpha", "0.99",
+                                "--param", "alpha", "--min", "0.97", "--max", "1", "--start", "0,-1.077,-2.595"],
+                               cwd=SOURCE, capture_output=True, text=True, timeout=120, env=env)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertEqual(sorted(os.listdir(results)), ["corner.csv", "corner.pdf", "corner.png"])
+            with open(os.path.join(results, "corner.csv")) as f:
+                text = f.read()
+            self.assertIn("on 2 ranks", text)
+            self.assertIn("neimark_sacker", text)
+            self.assertIn("branch_point", text)
 
     def test_batch_scripts_help_and_syntax(self):
         for script in ("slurm/explore.sbatch", "pbs/explore.pbs"):

@@ -175,7 +175,7 @@ public:
         const int pieces = static_cast<int>(std::clamp<std::uint64_t>(points / 512, 1, serves_ ? 8 : pieces_));
         for (int i = 0; i < pieces; ++i) {
             smpi_execute(cost / pieces);
-            serve();
+            if (serve) serve();
         }
         busy += cost;
         ++tiles;

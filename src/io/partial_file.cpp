@@ -1,0 +1,326 @@
+#include "partial_file.hpp"
+
+#include <fmt/core.h>
+#include <xxhash.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <type_traits>
+
+#include "hdf5.hpp"
+#include "layout.hpp"
+#include "result_metadata.hpp"
+
+namespace superball {
+
+static_assert(std::endian::native == std::endian::little,
+              "the partial file's chunks are written as bytes in memory order: little-endian hosts only");
+
+namespace {
+
+std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
+
+// A dataset whose chunks are the tiles, all allocated at creation and never filled. With
+// the HDF5 1.10 format, no filter and early allocation, HDF5 indexes the chunks
+// implicitly: chunk t lies at the dataset's first chunk plus t chunks (partial_layout
+// checks it), with no index to update, so ranks write chunks straight to their offsets.
+void create_tiled(hid_t file, const char* name, hid_t type, const Tiling& tiling)
+{
+    const h5::Id space = h5::simple_space(to_hsize(tiling.shape()));
+    const auto chunk = to_hsize(tiling.tile_shape());
+    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
+    h5::check(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), "H5Pset_chunk");
+    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER), "H5Pset_fill_time");
+    h5::dataset_id(H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
+}
+
+// A contiguous 1-D dataset of one entry per tile, zeros (no tile done yet).
+void create_journal(hid_t loc, const char* name, hid_t type, hsize_t n)
+{
+    const h5::Id space = h5::simple_space({n});
+    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
+    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC), "H5Pset_fill_time");
+    h5::dataset_id(H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
+}
+
+// Chunk `t`'s first element, as dataset coordinates.
+std::vector<hsize_t> chunk_origin(const Tiling& tiling, std::uint64_t t) { return to_hsize(tiling.box(t).start); }
+
+PartialLayout layout_of(hid_t file, const Tiling& tiling)
+{
+    PartialLayout l;
+    l.tiles = tiling.tiles();
+    l.chunk_points = 1;
+    for (const std::uint64_t s : tiling.tile_shape()) l.chunk_points *= s;
+    const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
+    const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
+    l.count_bytes = h5::dataset_shape_of(counts).bytes;
+    const auto contiguous_chunks = [&](hid_t d, std::uint64_t chunk_bytes) {
+        const std::uint64_t first = h5::chunk_offset(d, chunk_origin(tiling, 0));
+        const std::uint64_t last = h5::chunk_offset(d, chunk_origin(tiling, l.tiles - 1));
+        // The implicit chunk index allocates every chunk in one piece, in order. A file laid
+        // out otherwise (another writer, a future HDF5) is refused rather than scribbled on.
+        if (last != first + (l.tiles - 1) * chunk_bytes) {
+            throw h5::Error("the chunks of the partial file are not laid out one after the other");
+        }
+        return first;
+    };
+    l.counts_at = contiguous_chunks(counts, l.counts_chunk());
+    l.outcomes_at = contiguous_chunks(outcomes, l.outcomes_chunk());
+    l.done_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_done));
+    l.checksums_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_checksum));
+    return l;
+}
+
+// Places a tile's values, row-major over its box, into its chunk (row-major over the tile
+// shape; an edge tile's box is smaller and the rest of the chunk stays zero), converting
+// each value with `put`.
+template <class Put>
+void place(const Extent& box_count, const Extent& tile_shape, std::size_t n, Put&& put)
+{
+    const std::size_t d = tile_shape.size();
+    const std::size_t row = box_count[d - 1];
+    if (box_count == tile_shape) {
+        for (std::size_t i = 0; i < n; ++i) put(i, i);
+        return;
+    }
+    // Strides of the chunk.
+    Extent stride(d, 1);
+    for (std::size_t k = d - 1; k-- > 0;) stride[k] = stride[k + 1] * tile_shape[k + 1];
+    Extent index(d, 0);
+    for (std::size_t src = 0; src < n; src += row) {
+        std::size_t dst = 0;
+        for (std::size_t k = 0; k < d; ++k) dst += index[k] * stride[k];
+        for (std::size_t j = 0; j < row; ++j) put(dst + j, src + j);
+        for (std::size_t k = d - 1; k-- > 0;) {
+            if (++index[k] < box_count[k]) break;
+            index[k] = 0;
+        }
+    }
+}
+
+}  // namespace
+
+std::uint64_t tile_checksum(std::uint64_t tile, std::span<const std::byte> counts_chunk,
+                            std::span<const std::byte> outcomes_chunk)
+{
+    const XXH64_hash_t first = XXH3_64bits_withSeed(counts_chunk.data(), counts_chunk.size(), tile);
+    return XXH3_64bits_withSeed(outcomes_chunk.data(), outcomes_chunk.size(), first);
+}
+
+PartialLayout create_partial(const std::filesystem::path& path, const Job& job, const Grid& grid, const Tiling& tiling,
+                             int ranks)
+{
+    const h5::Id fapl = h5::file_access(job.alignment);
+    const h5::Id file = h5::create_file(path, fapl);
+    {
+        // The journal first: small, next to the metadata, away from the stripes of the data.
+        const h5::Id progress = h5::create_group(file, "/progress");
+        create_journal(file, layout::tile_done, H5T_STD_U8LE, tiling.tiles());
+        create_journal(file, layout::tile_checksum, H5T_STD_U64LE, tiling.tiles());
+    }
+    create_tiled(file, layout::wall_bounces, count_type(job), tiling);
+    create_tiled(file, layout::outcome, H5T_STD_U8LE, tiling);
+    const std::vector<h5::Id> axes = write_metadata(file, job, grid, layout::kind_partial, {ranks, 0.0, false}, true);
+    {
+        const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
+        const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
+        describe_data(counts, outcomes, job, axes);
+    }
+    h5::write_attribute(file, "tile_shape", tiling.tile_shape());
+    PartialLayout l = layout_of(file, tiling);
+    h5::check(H5Fflush(file, H5F_SCOPE_GLOBAL), "H5Fflush");
+    return l;
+}
+
+PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& tiling)
+{
+    return layout_of(h5::open_file(path, false), tiling);
+}
+
+double record_partial_run(const std::filesystem::path& path, double seconds, int ranks)
+{
+    const h5::Id file = h5::open_file(path, true);
+    const double total = h5::read_double_attribute(file, "wall_seconds") + seconds;
+    write_run_figures(file, {ranks, total, false});
+    return total;
+}
+
+// ------------------------------------------------------------------------- PartialFile
+
+PartialFile::PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout)
+    : path_(path), comm_(comm), tiling_(std::move(tiling)), layout_(layout), file_(path)
+{
+}
+
+std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums)
+{
+    // Contiguous shares: runs of consecutive tiles are read in one piece.
+    const auto ranks = static_cast<std::uint64_t>(comm_.size());
+    const auto rank = static_cast<std::uint64_t>(comm_.rank());
+    const std::uint64_t begin = done.size() * rank / ranks, end = done.size() * (rank + 1) / ranks;
+    const std::uint64_t cb = layout_.counts_chunk(), ob = layout_.outcomes_chunk();
+    constexpr std::uint64_t max_run = std::uint64_t{8} << 20;
+    const std::uint64_t run_tiles = std::max<std::uint64_t>(1, max_run / cb);
+    std::vector<std::byte> counts, outcomes;
+    std::vector<std::uint64_t> bad;
+    for (std::uint64_t i = begin; i < end;) {
+        std::uint64_t n = 1;
+        while (i + n < end && n < run_tiles && done[i + n] == done[i] + n) ++n;
+        counts.resize(n * cb);
+        outcomes.resize(n * ob);
+        file_.read_at(layout_.counts_at + done[i] * cb, counts.data(), counts.size());
+        file_.read_at(layout_.outcomes_at + done[i] * ob, outcomes.data(), outcomes.size());
+        for (std::uint64_t j = 0; j < n; ++j) {
+            const std::span<const std::byte> c(counts.data() + j * cb, cb), o(outcomes.data() + j * ob, ob);
+            if (tile_checksum(done[i + j], c, o) != checksums[i + j]) bad.push_back(done[i + j]);
+        }
+        i += n;
+    }
+    // Every rank's findings, in tile order (the shares are in order).
+    std::vector<double> mine(bad.begin(), bad.end());
+    std::vector<double> all = comm_.gather(mine);
+    std::vector<std::uint64_t> out(all.begin(), all.end());
+    comm_.broadcast(out);
+    return out;
+}
+
+// --------------------------------------------------------------------------- TileWriter
+
+TileWriter::TileWriter(PartialFile& file, std::uint64_t buffer_bytes)
+    : file_(file), capacity_tiles_(std::max<std::uint64_t>(1, buffer_bytes / file.layout().counts_chunk()))
+{
+}
+
+void TileWriter::add(std::uint64_t tile, std::span<const std::uint32_t> counts, std::span<const std::uint8_t> outcomes)
+{
+    Buffer* b = &buffers_[current_];
+    if (b->count > 0 && (tile != b->first + b->count || b->count == capacity_tiles_)) {
+        issue();
+        b = &buffers_[current_];
+    }
+    if (b->count == 0) b->first = tile;
+    const PartialLayout& l = file_.layout();
+    const std::uint64_t n = l.chunk_points;
+    const Box box = file_.tiling().box(tile);
+    const Extent& shape = file_.tiling().tile_shape();
+    const bool edge = box.points() != n;  // the chunk's points beyond the grid stay zero
+    const auto fill = [&](auto& v) {
+        // Grown once and reused: a resize after clear() would zero what is overwritten anyway.
+        if (v.size() < (b->count + 1) * n) v.resize((b->count + 1) * n);
+        auto* chunk = v.data() + b->count * n;
+        using T = std::remove_reference_t<decltype(*chunk)>;
+        if (edge) std::fill(chunk, chunk + n, T{0});
+        return chunk;
+    };
+    std::uint8_t* const o = fill(b->outcomes);
+    std::span<const std::byte> counts_bytes;
+    if (l.count_bytes == 2) {
+        std::uint16_t* const c = fill(b->counts16);
+        place(box.count, shape, counts.size(), [&](std::size_t dst, std::size_t src) {
+            c[dst] = static_cast<std::uint16_t>(counts[src]);
+        });
+        counts_bytes = std::as_bytes(std::span(c, n));
+    } else {
+        std::uint32_t* const c = fill(b->counts32);
+        place(box.count, shape, counts.size(), [&](std::size_t dst, std::size_t src) { c[dst] = counts[src]; });
+        counts_bytes = std::as_bytes(std::span(c, n));
+    }
+    place(box.count, shape, outcomes.size(), [&](std::size_t dst, std::size_t src) { o[dst] = outcomes[src]; });
+    b->reports.push_back({tile, tile_checksum(tile, counts_bytes, std::as_bytes(std::span(o, n)))});
+    ++b->count;
+}
+
+void TileWriter::issue()
+{
+    Buffer& b = buffers_[current_];
+    if (b.count == 0) return;
+    const PartialLayout& l = file_.layout();
+    const PosixFile& f = file_.file();
+    const void* counts = l.count_bytes == 2 ? static_cast<const void*>(b.counts16.data()) : b.counts32.data();
+    const std::uint64_t counts_at = l.counts_at + b.first * l.counts_chunk(), counts_bytes = b.count * l.counts_chunk();
+    const std::uint64_t outcomes_at = l.outcomes_at + b.first * l.outcomes_chunk(), outcomes_bytes = b.count * l.outcomes_chunk();
+    const void* outcomes = b.outcomes.data();
+    // A thread per write (a few per second at most): the buffer stays untouched until waited for.
+    b.written = std::async(std::launch::async, [&f, counts, counts_at, counts_bytes, outcomes, outcomes_at, outcomes_bytes] {
+        f.write_at(counts_at, counts, counts_bytes);
+        f.write_at(outcomes_at, outcomes, outcomes_bytes);
+    });
+    // The other buffer fills next, once its own writes are done.
+    current_ = 1 - current_;
+    complete(buffers_[current_]);
+}
+
+void TileWriter::complete(Buffer& b)
+{
+    if (b.count == 0) return;
+    try {
+        b.written.get();
+    } catch (const std::exception& e) {
+        throw h5::Error(fmt::format("writing tiles {} to {} to {} failed ({}){}; the tiles recorded done are kept: run "
+                                    "the same command with --resume once the cause is fixed",
+                                    b.first, b.first + b.count - 1, file_.path().string(), e.what(),
+                                    free_space_note(file_.path())));
+    }
+    written_.insert(written_.end(), b.reports.begin(), b.reports.end());
+    b.reports.clear();
+    b.count = 0;
+}
+
+std::vector<TileReport> TileWriter::flush()
+{
+    // At most one buffer is being written, the other one; issue() waits for it before the
+    // current buffer's writes are waited for, so reports keep the order of the tiles.
+    issue();
+    complete(buffers_[1 - current_]);
+    return std::exchange(written_, {});
+}
+
+// ------------------------------------------------------------------------------ Journal
+
+Journal::Journal(PartialFile& file, std::vector<std::uint8_t> done, std::vector<std::uint64_t> checksums,
+                 std::chrono::duration<double> interval)
+    : file_(file),
+      done_(std::move(done)),
+      checksums_(std::move(checksums)),
+      interval_(interval),
+      last_(std::chrono::steady_clock::now()),
+      dirty_begin_(done_.size())
+{
+    tiles_done_ = static_cast<std::uint64_t>(std::count(done_.begin(), done_.end(), std::uint8_t{1}));
+}
+
+void Journal::record(std::span<const TileReport> tiles)
+{
+    for (const TileReport& r : tiles) {
+        if (done_[r.tile] == 0) ++tiles_done_;
+        done_[r.tile] = 1;
+        checksums_[r.tile] = r.checksum;
+        dirty_begin_ = std::min(dirty_begin_, r.tile);
+        dirty_end_ = std::max(dirty_end_, r.tile + 1);
+    }
+}
+
+void Journal::checkpoint(bool now)
+{
+    const auto t = std::chrono::steady_clock::now();
+    if (dirty_end_ <= dirty_begin_ || (!now && t - last_ < interval_)) return;
+    const PartialLayout& l = file_.layout();
+    const std::uint64_t n = dirty_end_ - dirty_begin_;
+    try {
+        // Checksums before the flags that vouch for them.
+        file_.file().write_at(l.checksums_at + 8 * dirty_begin_, checksums_.data() + dirty_begin_, 8 * n);
+        file_.file().write_at(l.done_at + dirty_begin_, done_.data() + dirty_begin_, n);
+    } catch (const std::exception& e) {
+        throw h5::Error(fmt::format("recording tiles {} to {} done in {} failed ({}){}", dirty_begin_, dirty_end_ - 1,
+                                    file_.path().string(), e.what(), free_space_note(file_.path())));
+    }
+    last_ = t;
+    dirty_begin_ = done_.size();
+    dirty_end_ = 0;
+}
+
+}  // namespace superball

@@ -1,0 +1,129 @@
+#include "result_metadata.hpp"
+
+#include <string>
+
+#include "layout.hpp"
+#include "superball/version.hpp"
+
+namespace superball {
+
+namespace {
+
+void describe_variable(hid_t d, const std::string& name)
+{
+    const layout::VariableText t = layout::variable_text(name);
+    h5::write_text_attribute(d, "long_name", std::string(t.long_name));
+    h5::write_text_attribute(d, "units", std::string(t.units));
+}
+
+// A small contiguous float64 dataset, its space allocated at creation (parallel files
+// require it of datasets written independently).
+h5::Id create_doubles(hid_t file, const std::string& name, const std::vector<hsize_t>& dims)
+{
+    const h5::Id space = dims.empty() ? h5::space_id(H5Screate(H5S_SCALAR), "H5Screate") : h5::simple_space(dims);
+    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
+    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    return h5::dataset_id(H5Dcreate2(file, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
+                          "create " + name);
+}
+
+}  // namespace
+
+hid_t count_type(const Job& job) { return job.max_bounces > 65535 ? H5T_STD_U32LE : H5T_STD_U16LE; }
+
+std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid, const char* kind, const RunFigures& run,
+                                   bool write_samples)
+{
+    std::vector<h5::Id> axes;
+    std::vector<std::string> axis_names;
+    const std::vector<const Coordinate*> ranges = job.range_axes();
+    for (std::size_t k = 0; k < ranges.size(); ++k) {
+        const std::string& name = ranges[k]->name;
+        axis_names.push_back(name);
+        const std::vector<double>& s = grid.samples(k);
+        h5::Id d = create_doubles(file, "/" + name, {s.size()});
+        if (write_samples) {
+            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data()), "write /" + name);
+        }
+        describe_variable(d, name);
+        h5::make_dimension_scale(d, name);
+        axes.push_back(std::move(d));
+    }
+    // No /axes/<name> (the layout of superball 0.1): links there show up in netCDF tools as
+    // a group of duplicate dimensions.
+    for (const Coordinate& c : job.grid) {
+        if (c.is_range()) continue;
+        const h5::Id d = create_doubles(file, "/" + c.name, {});
+        if (write_samples) {
+            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &*c.fixed), "write /" + c.name);
+        }
+        describe_variable(d, c.name);
+        h5::write_attribute(file, "fixed_" + c.name, *c.fixed);
+    }
+
+    h5::write_attribute(file, layout::kind_attribute, kind);
+    h5::write_attribute(file, "superball_format", layout::format_version);
+    h5::write_text_attribute(file, "Conventions", "CF-1.8");
+    h5::write_text_attribute(file, "title", "superball: wall bounces of a superball between a floor and a wall, over a grid of launches");
+    h5::write_text_attribute(file, "source", std::string("superball ") + software_version);
+    // Not "coordinates": that is CF's keyword for auxiliary coordinates, which xarray takes.
+    h5::write_attribute(file, "coordinate_system", std::string(name(job.coordinates)));
+    h5::write_attribute(file, "axis_names", axis_names);
+    // A swept coefficient has no single value: its attribute names the axis instead
+    // ("axis:e"), and `swept` lists the coefficient axes.
+    const std::pair<const char*, double> coefficients[] = {{"e_wall", job.model.wall.e},
+                                                           {"alpha_wall", job.model.wall.alpha},
+                                                           {"e_floor", job.model.floor.e},
+                                                           {"alpha_floor", job.model.floor.alpha}};
+    for (std::size_t c = 0; c < 4; ++c) {
+        const auto [key, value] = coefficients[c];
+        if (job.swept[c] < 0) {
+            h5::write_attribute(file, key, value);
+        } else {
+            h5::write_attribute(file, key, "axis:" + job.parameters[static_cast<std::size_t>(job.swept[c])].name);
+        }
+    }
+    if (!job.parameters.empty()) {
+        std::vector<std::string> swept;
+        for (const Coordinate& p : job.parameters) swept.push_back(p.name);
+        h5::write_attribute(file, "swept", swept);
+    }
+    if (job.coordinates == Coordinates::physical) {
+        h5::write_attribute(file, "g", job.frame.g);
+        h5::write_attribute(file, "radius", job.frame.radius);
+    }
+    h5::write_attribute(file, "max_bounces", static_cast<std::int64_t>(job.max_bounces));
+    // 0: every point computed; s: adaptive refinement from every s-th point.
+    h5::write_attribute(file, "refine", static_cast<std::int64_t>(job.refine));
+    h5::write_attribute(file, "job_toml", job.text);
+    h5::write_attribute(file, "job_fingerprint", fingerprint(job));
+    h5::write_attribute(file, "software_version", std::string(software_version));
+    write_run_figures(file, run);
+    return axes;
+}
+
+void describe_data(hid_t wall_bounces, hid_t outcome, const Job& job, const std::vector<h5::Id>& axes)
+{
+    h5::write_text_attribute(wall_bounces, "long_name", "wall impacts before the motion ended, or max_bounces (capped)");
+    h5::write_text_attribute(wall_bounces, "units", "1");
+    h5::write_text_attribute(outcome, "long_name", "how the motion ended");
+    h5::write_attribute(outcome, "flag_values", std::span<const std::uint8_t>(layout::outcome_codes));
+    h5::write_text_attribute(outcome, "flag_meanings", layout::outcome_meanings);
+    std::string fixed;
+    for (const Coordinate& c : job.grid) {
+        if (!c.is_range()) fixed += (fixed.empty() ? "" : " ") + c.name;
+    }
+    for (const hid_t d : {wall_bounces, outcome}) {
+        if (!fixed.empty()) h5::write_text_attribute(d, "coordinates", fixed);
+        for (std::size_t k = 0; k < axes.size(); ++k) h5::attach_dimension_scale(d, axes[k], static_cast<unsigned>(k));
+    }
+}
+
+void write_run_figures(hid_t file, const RunFigures& run)
+{
+    h5::write_attribute(file, "mpi_ranks", run.mpi_ranks);
+    h5::write_attribute(file, "wall_seconds", run.wall_seconds);
+    h5::write_attribute(file, "complete", std::int64_t{run.complete ? 1 : 0});
+}
+
+}  // namespace superball

@@ -1,0 +1,882 @@
+#include "result_reader.hpp"
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <tuple>
+#include <set>
+#include <system_error>
+
+#include "job/job.hpp"
+#include "layout.hpp"
+#include "partial_file.hpp"
+
+namespace superball {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::int64_t max_max_bounces = 4294967295;
+// As the job parser: beyond 2^40 points a file is damaged, not big.
+constexpr std::uint64_t max_points = std::uint64_t{1} << 40;
+// Texts: a job file is a few hundred bytes; names and versions a few.
+constexpr std::size_t max_job_bytes = std::size_t{1} << 20;
+constexpr std::size_t max_text_bytes = 4096;
+
+std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
+
+// A text of a file, for a message: at most 60 characters, with control characters and
+// bytes that are not UTF-8 escaped (\xNN), so that a damaged file's bytes can neither
+// garble a terminal nor make the message unreadable.
+std::string printable(std::string_view text)
+{
+    std::string out;
+    std::size_t i = 0;
+    for (std::size_t shown = 0; i < text.size() && shown < 60; ++shown) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        // Length of the UTF-8 sequence c begins, 0 if it begins none.
+        const std::size_t n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+        bool valid = n > 0 && i + n <= text.size();
+        for (std::size_t k = 1; valid && k < n; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        if (n == 1 && c >= 0x20 && c != 0x7f) {
+            out += static_cast<char>(c);
+        } else if (valid && n > 1) {
+            out.append(text.substr(i, n));
+            i += n - 1;
+        } else {
+            out += fmt::format("\\x{:02x}", c);
+        }
+        ++i;
+    }
+    if (i < text.size()) out += "...";
+    return out;
+}
+
+std::vector<std::string> printable(const std::vector<std::string>& texts)
+{
+    std::vector<std::string> out;
+    for (const std::string& t : texts) out.push_back(printable(t));
+    return out;
+}
+
+std::string dims_text(const std::vector<hsize_t>& dims)
+{
+    return dims.empty() ? "a scalar" : fmt::format("({})", fmt::join(dims, ", "));
+}
+
+bool is_coefficient(const std::string& n)
+{
+    static const std::vector<std::string> names = coefficient_names();
+    return std::find(names.begin(), names.end(), n) != names.end();
+}
+
+// Whether coefficient attribute `key` (e_wall, ...) may be swept by the axis `axis`: its
+// own name, or the shorthand of its kind (e, alpha) that sets both surfaces.
+bool sweeps(std::string_view axis, std::string_view key) { return axis == key || axis == key.substr(0, key.find('_')); }
+
+// Names of the coordinates of a coordinate system, in result order.
+std::vector<std::string> coordinates_of(const std::string& system)
+{
+    if (system == "canonical") return {"xi", "U", "W"};
+    return {"x", "u", "v", "omega"};
+}
+
+// What an attribute or dataset holds, for messages: "a text", "a list of 2 integers", ...
+std::string shape_text(const h5::Shape& s)
+{
+    const char* kind = "value of another type";
+    switch (s.type) {
+        case h5::TypeClass::string: kind = "text"; break;
+        case h5::TypeClass::integer: kind = "integer"; break;
+        case h5::TypeClass::floating: kind = "floating-point number"; break;
+        case h5::TypeClass::other: break;
+    }
+    if (s.scalar) return fmt::format("{} {}", s.type == h5::TypeClass::integer ? "an" : "a", kind);
+    if (s.elements() == 0) return "empty";
+    if (s.dims.size() == 1) return fmt::format("a list of {} {}s", s.dims[0], kind);
+    return fmt::format("an array {} of {}s", dims_text(s.dims), kind);
+}
+
+class Checker {
+public:
+    Checker(hid_t file, const fs::path& path) : file_(file), path_(path.string()) {}
+
+    [[noreturn]] void fail(const std::string& what) const { throw FormatError(path_ + ": " + what); }
+
+    // Root attributes of the kinds the format uses, each checked for its type and shape
+    // before it is read.
+    std::string text(const std::string& name, std::size_t max_bytes = max_text_bytes) const
+    {
+        const h5::Shape s = shape(name);
+        if (s.type != h5::TypeClass::string || !s.scalar) fail("attribute " + name + " is " + shape_text(s) + ", not a text");
+        if (!s.variable_length && s.bytes > max_bytes) too_long(name, s.bytes, max_bytes);
+        std::string v = h5::read_string_attribute(file_, name);
+        if (v.size() > max_bytes) too_long(name, v.size(), max_bytes);
+        return v;
+    }
+    std::int64_t integer(const std::string& name, std::int64_t lo, std::int64_t hi) const
+    {
+        const h5::Shape s = shape(name);
+        if (s.type != h5::TypeClass::integer || !s.scalar) {
+            fail("attribute " + name + " is " + shape_text(s) + ", not an integer");
+        }
+        const std::int64_t v = h5::read_int_attribute(file_, name);
+        if (v < lo || v > hi) fail(fmt::format("attribute {} = {} is out of range: accepted {} to {}", name, v, lo, hi));
+        return v;
+    }
+    double number(const std::string& name) const
+    {
+        const h5::Shape s = shape(name);
+        if ((s.type != h5::TypeClass::floating && s.type != h5::TypeClass::integer) || !s.scalar) {
+            fail("attribute " + name + " is " + shape_text(s) + ", not a number");
+        }
+        const double v = h5::read_double_attribute(file_, name);
+        if (!std::isfinite(v)) fail(fmt::format("attribute {} = {} is not finite", name, v));
+        return v;
+    }
+    std::vector<std::string> texts(const std::string& name, std::size_t max_items) const
+    {
+        const h5::Shape s = shape(name);
+        if (s.type != h5::TypeClass::string || s.dims.size() != 1) {
+            fail("attribute " + name + " is " + shape_text(s) + ", not a list of texts");
+        }
+        if (s.dims[0] < 1 || s.dims[0] > max_items) {
+            fail(fmt::format("attribute {} lists {} items: accepted 1 to {}", name, s.dims[0], max_items));
+        }
+        if (!s.variable_length && s.bytes > max_text_bytes) too_long(name, s.bytes, max_text_bytes);
+        std::vector<std::string> v = h5::read_string_vector_attribute(file_, name);
+        for (const std::string& t : v) {
+            if (t.size() > max_text_bytes) too_long(name, t.size(), max_text_bytes);
+        }
+        return v;
+    }
+    std::vector<std::uint64_t> integers(const std::string& name, std::size_t items) const
+    {
+        const h5::Shape s = shape(name);
+        if (s.type != h5::TypeClass::integer || s.dims.size() != 1) {
+            fail("attribute " + name + " is " + shape_text(s) + ", not a list of integers");
+        }
+        if (s.dims[0] != items) fail(fmt::format("attribute {} lists {} integers for {} dimensions", name, s.dims[0], items));
+        return h5::read_u64_vector_attribute(file_, name);
+    }
+
+    h5::Id dataset(const std::string& name) const
+    {
+        if (h5::object_type(file_, name) != h5::ObjectType::dataset) fail(name + " is missing or not a dataset");
+        return h5::open_dataset(file_, name);
+    }
+
+    // The data of `name` are all stored (a chunk never written would read as zeros).
+    void allocated(hid_t d, const std::string& name) const
+    {
+        if (!h5::dataset_storage(d).allocated) fail(name + " lacks storage for part of its data: the file is incomplete or damaged");
+    }
+
+private:
+    h5::Shape shape(const std::string& name) const
+    {
+        const std::optional<h5::Shape> s = h5::attribute_shape(file_, name);
+        if (!s) fail("attribute " + name + " is missing");
+        return *s;
+    }
+    [[noreturn]] void too_long(const std::string& name, std::size_t bytes, std::size_t max) const
+    {
+        fail(fmt::format("attribute {} holds a text of {} bytes: accepted at most {}", name, bytes, max));
+    }
+
+    hid_t file_;
+    std::string path_;
+};
+
+// Opens `path` read-only, saying what it is when it is not HDF5 at all.
+h5::Id open_hdf5(const fs::path& path)
+{
+    const std::string p = path.string();
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw FormatError(p + ": no such file");
+    if (!fs::is_regular_file(path, ec)) throw FormatError(p + " is " + describe_file(path) + ", not a superball file");
+    if (!h5::is_hdf5(path)) throw FormatError(p + " is " + describe_file(path) + ", not a superball result");
+    try {
+        return h5::open_file(path, false);
+    } catch (const h5::Error& e) {
+        throw FormatError(p + " is an HDF5 file that cannot be opened, damaged or truncated (" + e.what() + ")");
+    }
+}
+
+// Whether the bytes at the beginning or end of a file HDF5 cannot read name superball's
+// two datasets, wall_bounces and outcome: the root group's links, in the first few KiB of
+// every superball file (its attributes may lie past a truncation). Only a file HDF5 cannot
+// open is judged so; one it opens is superball's by its attributes.
+bool has_superball_marks(const fs::path& path, std::uint64_t size)
+{
+    constexpr std::uint64_t span = 64 * 1024;
+    std::ifstream in(path, std::ios::binary);
+    std::string bytes;
+    for (const std::uint64_t at : {std::uint64_t{0}, size > span ? size - span : std::uint64_t{0}}) {
+        std::string part(static_cast<std::size_t>(std::min(span, size)), '\0');
+        in.seekg(static_cast<std::streamoff>(at));
+        in.read(part.data(), static_cast<std::streamsize>(part.size()));
+        part.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+        in.clear();
+        bytes += part;
+    }
+    const auto has = [&](std::string_view s) { return bytes.find(s) != std::string::npos; };
+    return has("wall_bounces") && has("outcome");
+}
+
+// The byte ranges of the file's big raw data, which damaged_global_heap need not search:
+// contiguous datasets, and chunked ones without filters whose chunks lie one after the
+// other (a partial file's). Whatever cannot be told is searched.
+std::vector<std::pair<std::uint64_t, std::uint64_t>> raw_data_ranges(hid_t file)
+{
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
+    for (const char* name : {layout::wall_bounces, layout::outcome, layout::tile_done, layout::tile_checksum}) {
+        try {
+            if (h5::object_type(file, name) != h5::ObjectType::dataset) continue;
+            const h5::Id d = h5::open_dataset(file, name);
+            const h5::Shape s = h5::dataset_shape_of(d);
+            const h5::Storage st = h5::dataset_storage(d);
+            if (st.chunk.empty()) {
+                if (const haddr_t at = H5Dget_offset(d); at != HADDR_UNDEF) ranges.emplace_back(at, H5Dget_storage_size(d));
+                continue;
+            }
+            if (st.filters != 0 || !st.allocated || s.elements() == 0) continue;
+            std::uint64_t chunk_bytes = s.bytes, chunks = 1;
+            std::vector<hsize_t> last(s.dims.size());
+            for (std::size_t k = 0; k < s.dims.size(); ++k) {
+                chunk_bytes *= st.chunk[k];
+                chunks *= (s.dims[k] + st.chunk[k] - 1) / st.chunk[k];
+                last[k] = (s.dims[k] - 1) / st.chunk[k] * st.chunk[k];
+            }
+            const std::uint64_t first_at = h5::chunk_offset(d, std::vector<hsize_t>(s.dims.size(), 0));
+            if (h5::chunk_offset(d, last) == first_at + (chunks - 1) * chunk_bytes) {
+                ranges.emplace_back(first_at, chunks * chunk_bytes);
+            }
+        } catch (const h5::Error&) {
+        }
+    }
+    return ranges;
+}
+
+}  // namespace
+
+std::uint64_t ResultInfo::points() const
+{
+    std::uint64_t n = 1;
+    for (const std::uint64_t s : shape) n *= s;
+    return n;
+}
+
+FileIdentity identify_file(const fs::path& path)
+{
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec || !fs::exists(st)) return {false, "nothing (no such file)"};
+    if (fs::is_directory(st)) return {false, "a directory"};
+    if (!fs::is_regular_file(st)) return {false, "not a regular file"};
+    const auto size = fs::file_size(path, ec);
+    if (!ec && size == 0) return {false, "an empty file"};
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return {false, "a file that cannot be read (" + std::error_code(errno, std::generic_category()).message() + ")"};
+    if (h5::is_hdf5(path)) {
+        std::string why;
+        try {
+            const h5::Id f = h5::open_file(path, false);
+            if (h5::has_attribute(f, layout::kind_attribute) || h5::has_attribute(f, "job_toml")) {
+                return {true, "a superball file"};
+            }
+            why = "it opens, but has none of superball's attributes";
+        } catch (const h5::Error& e) {
+            why = e.what();
+        }
+        if (has_superball_marks(path, size)) return {true, "a damaged superball file (" + why + ")"};
+        if (why.rfind("it opens", 0) == 0) return {false, "an HDF5 file that is not superball's"};
+        return {false, "an HDF5 file that cannot be opened (damaged or truncated) and shows nothing of superball's"};
+    }
+    std::string head(512, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    const bool text = std::all_of(head.begin(), head.end(), [](char c) {
+        const auto u = static_cast<unsigned char>(c);
+        return u >= 0x20 || c == '\n' || c == '\r' || c == '\t';
+    });
+    if (!text) return {false, fmt::format("a binary file of {} bytes", size)};
+    const std::string first = head.substr(0, head.find('\n')).substr(0, 40);
+    return {false, fmt::format("a text file of {} bytes, beginning \"{}\"", size, printable(first))};
+}
+
+std::string describe_file(const fs::path& path) { return identify_file(path).description; }
+
+ResultReader::ResultReader(const fs::path& path) : path_(path), file_(open_hdf5(path))
+{
+    try {
+        validate();
+    } catch (const h5::Error& e) {
+        // A structure HDF5 itself cannot read (checksums of its metadata, broken links).
+        throw FormatError(path.string() + " is damaged: " + e.what());
+    }
+}
+
+void ResultReader::validate()
+{
+    const Checker check(file_, path_);
+    ResultInfo& in = info_;
+
+    // Before any text is read: HDF5 reads variable-length values without checking them.
+    if (const std::optional<std::uint64_t> at = h5::damaged_global_heap(path_, raw_data_ranges(file_))) {
+        check.fail(fmt::format("the global heap at byte {} (where HDF5 keeps texts and dimension-scale lists) is damaged: "
+                               "its objects do not fit it",
+                               *at));
+    }
+
+    // What the file is.
+    if (!h5::has_attribute(file_, layout::kind_attribute)) {
+        // Attributes only this layout has: the file is of this layout, damaged.
+        if (h5::has_attribute(file_, "superball_format") || h5::has_attribute(file_, "coordinate_system")) {
+            check.fail("attribute " + std::string(layout::kind_attribute) + " is missing");
+        }
+        if (h5::has_attribute(file_, "job_toml") && h5::has_attribute(file_, "software_version")) {
+            std::string version = "?";
+            try {
+                version = h5::read_string_attribute(file_, "software_version");
+            } catch (const h5::Error&) {
+            }
+            check.fail("written by superball " + printable(version) +
+                       " in the layout before netCDF conventions, which this version does not read; run the job again "
+                       "with this version");
+        }
+        check.fail("an HDF5 file that is not a superball result (no attribute " + std::string(layout::kind_attribute) + ")");
+    }
+    const std::string kind = check.text(layout::kind_attribute);
+    if (kind != layout::kind_result && kind != layout::kind_partial) {
+        check.fail(fmt::format("attribute {} = \"{}\" is neither \"{}\" nor \"{}\"", layout::kind_attribute, printable(kind),
+                               layout::kind_result, layout::kind_partial));
+    }
+    in.kind = kind == layout::kind_result ? FileKind::result : FileKind::partial;
+    if (const std::int64_t format = check.integer("superball_format", 0, std::numeric_limits<std::int64_t>::max());
+        format != layout::format_version) {
+        check.fail(fmt::format("attribute superball_format = {}: this version of superball reads format {} only; read the "
+                               "file with the version that wrote it",
+                               format, layout::format_version));
+    }
+
+    // The grid's coordinates and axes.
+    in.coordinate_system = check.text("coordinate_system");
+    if (in.coordinate_system != "canonical" && in.coordinate_system != "physical") {
+        check.fail("attribute coordinate_system = \"" + printable(in.coordinate_system) + "\" is neither canonical nor physical");
+    }
+    const std::vector<std::string> coordinates = coordinates_of(in.coordinate_system);
+    in.axis_names = check.texts("axis_names", 4);
+    std::set<std::string> seen;
+    std::ptrdiff_t last_coordinate = -1;
+    for (const std::string& a : in.axis_names) {
+        const auto c = std::find(coordinates.begin(), coordinates.end(), a);
+        if (c == coordinates.end() && !is_coefficient(a)) {
+            check.fail(fmt::format("attribute axis_names names \"{}\", which is neither a {} coordinate ({}) nor a model "
+                                   "coefficient ({})",
+                                   printable(a), in.coordinate_system, fmt::join(coordinates, ", "),
+                                   fmt::join(coefficient_names(), ", ")));
+        }
+        if (!seen.insert(a).second) check.fail("attribute axis_names names \"" + a + "\" twice");
+        // Swept coefficients first, then the coordinates in their order (as written).
+        const std::ptrdiff_t order = c == coordinates.end() ? -1 : c - coordinates.begin();
+        if (order < last_coordinate) {
+            check.fail(fmt::format("attribute axis_names lists ({}) out of order: swept coefficients first, then {}",
+                                   fmt::join(printable(in.axis_names), ", "), fmt::join(coordinates, ", ")));
+        }
+        last_coordinate = std::max(last_coordinate, order);
+    }
+    for (const std::string& c : coordinates) {
+        if (std::find(in.axis_names.begin(), in.axis_names.end(), c) == in.axis_names.end()) {
+            in.fixed.emplace_back(c, check.number("fixed_" + c));
+        }
+    }
+    if (in.fixed.size() + 3 < coordinates.size()) {
+        check.fail(fmt::format("attribute axis_names lists {} {} coordinates: a grid has at most 3 ranges",
+                               coordinates.size() - in.fixed.size(), in.coordinate_system));
+    }
+
+    // The job, the run and the model.
+    in.max_bounces = check.integer("max_bounces", 1, max_max_bounces);
+    in.software_version = check.text("software_version");
+    in.job_toml = check.text("job_toml", max_job_bytes);
+    in.job_fingerprint = check.text("job_fingerprint", max_job_bytes);
+    in.mpi_ranks = check.integer("mpi_ranks", 0, std::int64_t{1} << 40);
+    in.wall_seconds = check.number("wall_seconds");
+    if (in.wall_seconds < 0) check.fail(fmt::format("attribute wall_seconds = {} is negative", in.wall_seconds));
+    in.complete = check.integer("complete", 0, 1) == 1;
+    if (in.kind == FileKind::result && !in.complete) {
+        check.fail("attribute complete = 0 contradicts superball_file = result (a result is written complete)");
+    }
+    if (in.kind == FileKind::partial && in.complete) {
+        check.fail("attribute complete = 1 contradicts superball_file = partial (a run in progress)");
+    }
+    // A coefficient is a number in its range, or names the axis that sweeps it.
+    std::set<std::string> swept;
+    for (const char* key : {"e_wall", "alpha_wall", "e_floor", "alpha_floor"}) {
+        const std::optional<h5::Shape> s = h5::attribute_shape(file_, key);
+        if (s && s->type == h5::TypeClass::string) {
+            const std::string v = check.text(key);
+            const std::string axis = v.rfind("axis:", 0) == 0 ? v.substr(5) : "";
+            if (std::find(in.axis_names.begin(), in.axis_names.end(), axis) == in.axis_names.end() || !sweeps(axis, key)) {
+                check.fail(fmt::format("attribute {} = \"{}\" names no axis of the file that sweeps {}", key, printable(v), key));
+            }
+            swept.insert(axis);
+            continue;
+        }
+        const double v = check.number(key);
+        const bool normal = key[0] == 'e';
+        if (normal ? !(v > 0 && v <= 1) : !(v >= -1 && v <= 1)) {
+            check.fail(fmt::format("attribute {} = {} is out of range: accepted {}", key, v,
+                                   normal ? "0 < e <= 1" : "-1 <= alpha <= 1"));
+        }
+    }
+    for (const std::string& a : in.axis_names) {
+        if (is_coefficient(a) && !swept.count(a)) {
+            check.fail("attribute axis_names names the coefficient " + a + ", but no coefficient attribute says \"axis:" + a +
+                       "\"");
+        }
+    }
+    if (in.coordinate_system == "physical") {
+        for (const char* key : {"g", "radius"}) {
+            if (const double v = check.number(key); !(v > 0)) {
+                check.fail(fmt::format("attribute {} = {} is out of range: accepted > 0", key, v));
+            }
+        }
+    }
+
+    // The data.
+    counts_ = check.dataset(layout::wall_bounces);
+    outcomes_ = check.dataset(layout::outcome);
+    const h5::Shape cs = h5::dataset_shape_of(counts_);
+    const h5::Shape os = h5::dataset_shape_of(outcomes_);
+    // A partial file's bytes are written and checksummed as they lie in memory: little-endian.
+    const bool any_order = in.kind == FileKind::result;
+    if (cs.type != h5::TypeClass::integer || cs.is_signed || (cs.bytes != 2 && cs.bytes != 4) ||
+        !(any_order || cs.little_endian)) {
+        check.fail(fmt::format("/wall_bounces holds {}{}: accepted unsigned 16- or 32-bit integers{}", shape_text(cs),
+                               cs.type == h5::TypeClass::integer
+                                   ? fmt::format(" of {} bits, {}", 8 * cs.bytes, cs.is_signed ? "signed" : "unsigned")
+                                   : "",
+                               any_order ? "" : " (little-endian)"));
+    }
+    if (os.type != h5::TypeClass::integer || os.is_signed || os.bytes != 1) {
+        check.fail(fmt::format("/outcome holds {}{}: accepted unsigned 8-bit integers", shape_text(os),
+                               os.type == h5::TypeClass::integer
+                                   ? fmt::format(" of {} bits, {}", 8 * os.bytes, os.is_signed ? "signed" : "unsigned")
+                                   : ""));
+    }
+    if (cs.scalar || cs.dims.size() != in.axis_names.size()) {
+        check.fail(fmt::format("/wall_bounces has {} dimensions {} but axis_names lists {} axes ({})", cs.dims.size(),
+                               dims_text(cs.dims), in.axis_names.size(), fmt::join(in.axis_names, ", ")));
+    }
+    if (os.scalar || os.dims != cs.dims) {
+        check.fail("/outcome " + dims_text(os.dims) + " and /wall_bounces " + dims_text(cs.dims) + " differ in shape");
+    }
+    std::uint64_t points = 1;
+    for (const hsize_t n : cs.dims) {
+        if (n == 0) check.fail("/wall_bounces " + dims_text(cs.dims) + " is empty");
+        if (__builtin_mul_overflow(points, n, &points) || points > max_points) {
+            check.fail(fmt::format("/wall_bounces {} has more than 2^40 points", dims_text(cs.dims)));
+        }
+    }
+    in.shape.assign(cs.dims.begin(), cs.dims.end());
+    in.count_bytes = cs.bytes;
+    if (in.max_bounces > 65535 && in.count_bytes == 2) {
+        check.fail(fmt::format("max_bounces = {} does not fit the 16-bit counts of /wall_bounces", in.max_bounces));
+    }
+    check.allocated(counts_, layout::wall_bounces);
+    check.allocated(outcomes_, layout::outcome);
+
+    // Coordinate variables: each axis's samples, a dimension scale attached to its
+    // dimension of both datasets (what xarray and netCDF tools read as its coordinate).
+    const auto attached = [&](hid_t data, const char* data_name) {
+        std::vector<std::vector<haddr_t>> scales;
+        try {
+            scales = h5::attached_scales(data);
+        } catch (const h5::Error& e) {
+            check.fail(std::string(data_name) + ": " + e.what());
+        }
+        if (scales.size() != in.axis_names.size()) {
+            check.fail(fmt::format("{} has {} dimension scales attached (attribute DIMENSION_LIST) for its {} dimensions",
+                                   data_name, scales.size(), in.axis_names.size()));
+        }
+        return scales;
+    };
+    const std::vector<std::vector<haddr_t>> count_scales = attached(counts_, layout::wall_bounces);
+    const std::vector<std::vector<haddr_t>> outcome_scales = attached(outcomes_, layout::outcome);
+    for (std::size_t k = 0; k < in.axis_names.size(); ++k) {
+        axis(k);
+        const std::string name = "/" + in.axis_names[k];
+        const h5::Id d = h5::open_dataset(file_, name);
+        const std::optional<h5::Shape> cls = h5::attribute_shape(d, "CLASS");
+        if (!cls || cls->type != h5::TypeClass::string || !cls->scalar || cls->bytes > 64 ||
+            h5::read_string_attribute(d, "CLASS") != "DIMENSION_SCALE") {
+            check.fail(name + " is not a dimension scale (its attribute CLASS is not \"DIMENSION_SCALE\")");
+        }
+        const haddr_t at = h5::object_address(d);
+        for (const auto& [scales, data_name] : {std::pair{&count_scales, layout::wall_bounces},
+                                                std::pair{&outcome_scales, layout::outcome}}) {
+            const std::vector<haddr_t>& s = (*scales)[k];
+            if (std::find(s.begin(), s.end(), at) == s.end()) {
+                check.fail(fmt::format("{} is not attached to dimension {} of {}, which axis_names says is {}", name, k,
+                                       data_name, in.axis_names[k]));
+            }
+        }
+    }
+    // Fixed coordinates: scalar variables agreeing with the attributes.
+    for (const auto& [name, value] : in.fixed) {
+        const std::string v = "/" + name;
+        const h5::Id d = check.dataset(v);
+        const h5::Shape s = h5::dataset_shape_of(d);
+        if (s.type != h5::TypeClass::floating || !s.scalar) {
+            check.fail(fmt::format("{} holds {}, not one floating-point number (the fixed coordinate {})", v, shape_text(s),
+                                   name));
+        }
+        check.allocated(d, v);
+        double x = 0;
+        h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &x), "read " + v);
+        if (!(x == value)) check.fail(fmt::format("{} = {} contradicts attribute fixed_{} = {}", v, x, name, value));
+    }
+
+    if (in.kind == FileKind::partial) {
+        validate_partial();
+        return;
+    }
+    // A result is complete: a resume journal belongs to a run in progress.
+    if (h5::object_type(file_, "/progress") != h5::ObjectType::missing) {
+        std::string journal;
+        if (h5::object_type(file_, layout::tile_done) == h5::ObjectType::dataset) {
+            const h5::Id d = h5::open_dataset(file_, layout::tile_done);
+            const h5::Shape s = h5::dataset_shape_of(d);
+            if (s.type == h5::TypeClass::integer && s.bytes == 1 && s.dims.size() == 1 && s.dims[0] <= max_points &&
+                h5::dataset_storage(d).allocated) {
+                std::vector<std::uint8_t> flags(s.dims[0]);
+                h5::check(H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, flags.data()),
+                          "read " + std::string(layout::tile_done));
+                journal = fmt::format(", /progress/tile_done, recording {} of {} tiles done", std::count(flags.begin(), flags.end(), 1),
+                                      flags.size());
+            }
+        }
+        check.fail(fmt::format("superball_file = result and complete = 1 say the run is complete, but the file holds a resume "
+                               "journal{}: the file contradicts itself",
+                               journal.empty() ? " (/progress), which only a run in progress has" : journal));
+    }
+}
+
+void ResultReader::validate_partial()
+{
+    const Checker check(file_, path_);
+    ResultInfo& in = info_;
+    in.tile_shape = check.integers("tile_shape", in.shape.size());
+    for (std::size_t k = 0; k < in.shape.size(); ++k) {
+        if (in.tile_shape[k] < 1 || in.tile_shape[k] > in.shape[k]) {
+            check.fail(fmt::format("attribute tile_shape = ({}) does not fit the data ({})", fmt::join(in.tile_shape, ", "),
+                                   fmt::join(in.shape, ", ")));
+        }
+    }
+    tiling_.emplace(in.shape, in.tile_shape);
+    in.tiles = tiling_->tiles();
+    // One uncompressed chunk per tile: resume writes each tile's bytes straight to its chunk.
+    for (const auto& [d, name] : {std::pair{counts_.get(), layout::wall_bounces}, std::pair{outcomes_.get(), layout::outcome}}) {
+        const h5::Storage st = h5::dataset_storage(d);
+        if (st.chunk != std::vector<hsize_t>(in.tile_shape.begin(), in.tile_shape.end()) || st.filters != 0) {
+            check.fail(fmt::format("{} is stored {}{}, not in uncompressed chunks of tile_shape ({}) as a partial file is",
+                                   name, st.chunk.empty() ? "unchunked" : "in chunks of " + dims_text(st.chunk),
+                                   st.filters ? fmt::format(" through {} filters", st.filters) : "",
+                                   fmt::join(in.tile_shape, ", ")));
+        }
+    }
+    for (const char* name : {layout::tile_done, layout::tile_checksum}) {
+        const h5::Id d = check.dataset(name);
+        const h5::Shape s = h5::dataset_shape_of(d);
+        const std::size_t bytes = name == layout::tile_done ? 1 : 8;
+        if (s.type != h5::TypeClass::integer || s.is_signed || s.bytes != bytes || !s.little_endian ||
+            s.dims != std::vector<hsize_t>{in.tiles}) {
+            check.fail(fmt::format("{} holds {} but tile_shape ({}) makes {} tiles: accepted {} unsigned {}-bit integers, "
+                                   "one per tile",
+                                   name, shape_text(s), fmt::join(in.tile_shape, ", "), in.tiles, in.tiles, 8 * bytes));
+        }
+        check.allocated(d, name);
+    }
+    done_.resize(in.tiles);
+    sums_.resize(in.tiles);
+    h5::check(H5Dread(h5::open_dataset(file_, layout::tile_done), H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                      done_.data()),
+              "read " + std::string(layout::tile_done));
+    h5::check(H5Dread(h5::open_dataset(file_, layout::tile_checksum), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                      sums_.data()),
+              "read " + std::string(layout::tile_checksum));
+    for (std::uint64_t t = 0; t < in.tiles; ++t) {
+        if (done_[t] > 1) check.fail(fmt::format("{} holds {} for tile {}: accepted 0 or 1", layout::tile_done, done_[t], t));
+    }
+    in.tiles_done = static_cast<std::uint64_t>(std::count(done_.begin(), done_.end(), std::uint8_t{1}));
+    verified_.assign(in.tiles, 0);
+}
+
+std::vector<double> ResultReader::axis(std::size_t k) const
+{
+    const std::string name = "/" + info_.axis_names.at(k);
+    const Checker check(file_, path_);
+    try {
+        const h5::Id d = check.dataset(name);
+        const h5::Shape s = h5::dataset_shape_of(d);
+        if (s.type != h5::TypeClass::floating || s.dims != std::vector<hsize_t>{info_.shape[k]}) {
+            check.fail(fmt::format("{} holds {}, not {} floating-point samples (dimension {} of the data)", name,
+                                   shape_text(s), info_.shape[k], k));
+        }
+        check.allocated(d, name);
+        std::vector<double> v(info_.shape[k]);
+        h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), "read " + name);
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            if (!std::isfinite(v[i])) check.fail(fmt::format("{} holds {} at {}: samples must be finite", name, v[i], i));
+            if (i > 0 && !(v[i] > v[i - 1])) {
+                check.fail(fmt::format("{} is not increasing at {} ({} after {})", name, i, v[i], v[i - 1]));
+            }
+        }
+        return v;
+    } catch (const h5::Error& e) {
+        throw FormatError(path_.string() + ": " + name + " cannot be read (" + e.what() + "); the file is damaged");
+    }
+}
+
+std::vector<std::uint8_t> ResultReader::tiles_done() const { return done_; }
+
+std::vector<std::uint64_t> ResultReader::tile_checksums() const { return sums_; }
+
+bool ResultReader::tile_intact(std::uint64_t t) const
+{
+    // The chunks as stored, the bytes the checksum was taken of.
+    const std::vector<hsize_t> origin = to_hsize(tiling_->box(t).start);
+    std::uint64_t chunk_points = 1;
+    for (const std::uint64_t n : info_.tile_shape) chunk_points *= n;
+    std::vector<std::byte> counts, outcomes;
+    for (auto [d, buf, bytes] : {std::tuple{counts_.get(), &counts, info_.count_bytes},
+                                 std::tuple{outcomes_.get(), &outcomes, std::size_t{1}}}) {
+        hsize_t stored = 0;
+        if (H5Dget_chunk_storage_size(d, origin.data(), &stored) < 0 || stored != chunk_points * bytes) return false;
+        buf->resize(stored);
+        std::uint32_t filters = 0;
+        if (H5Dread_chunk(d, H5P_DEFAULT, origin.data(), &filters, buf->data()) < 0) return false;
+    }
+    return tile_checksum(t, counts, outcomes) == sums_[t];
+}
+
+std::vector<std::uint64_t> ResultReader::damaged_tiles() const
+{
+    std::vector<std::uint64_t> bad;
+    if (info_.kind != FileKind::partial) return bad;
+    for (std::uint64_t t = 0; t < info_.tiles; ++t) {
+        if (done_[t] == 0) continue;
+        if (tile_intact(t)) {
+            verified_[t] = 1;
+        } else {
+            bad.push_back(t);
+        }
+    }
+    return bad;
+}
+
+void ResultReader::verify_tiles(const Box& box) const
+{
+    if (info_.kind != FileKind::partial || info_.tiles_done == 0) return;
+    const std::size_t d = box.count.size();
+    const Extent& ts = info_.tile_shape;
+    // The tiles the box meets: a box of tile indices.
+    Extent first(d), last(d), per_axis(d), index(d);
+    for (std::size_t k = 0; k < d; ++k) {
+        first[k] = box.start[k] / ts[k];
+        last[k] = (box.start[k] + box.count[k] - 1) / ts[k];
+        per_axis[k] = (info_.shape[k] + ts[k] - 1) / ts[k];
+        index[k] = first[k];
+    }
+    for (;;) {
+        std::uint64_t t = 0;
+        for (std::size_t k = 0; k < d; ++k) t = t * per_axis[k] + index[k];
+        if (done_[t] != 0 && verified_[t] == 0) {
+            if (!tile_intact(t)) {
+                const Box b = tiling_->box(t);
+                std::vector<std::string> span;
+                for (std::size_t k = 0; k < d; ++k) {
+                    span.push_back(fmt::format("{} {}..{}", info_.axis_names[k], b.start[k], b.start[k] + b.count[k] - 1));
+                }
+                throw FormatError(fmt::format(
+                    "{}: tile {} ({}) is recorded done in {}, but its data in /wall_bounces and /outcome no longer match {}: "
+                    "the file is damaged",
+                    path_.string(), t, fmt::join(span, ", "), layout::tile_done, layout::tile_checksum));
+            }
+            verified_[t] = 1;
+        }
+        std::size_t k = d;
+        while (k-- > 0) {
+            if (++index[k] <= last[k]) break;
+            index[k] = first[k];
+        }
+        if (k == static_cast<std::size_t>(-1)) return;
+    }
+}
+
+std::uint64_t ResultReader::read(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const
+{
+    // The caller's box: a programming error, not a damaged file.
+    bool fits = box.start.size() == info_.shape.size() && box.count.size() == info_.shape.size();
+    for (std::size_t k = 0; fits && k < info_.shape.size(); ++k) {
+        fits = box.count[k] >= 1 && box.start[k] < info_.shape[k] && box.count[k] <= info_.shape[k] - box.start[k];
+    }
+    if (!fits || counts.size() != box.points() || outcomes.size() != box.points()) {
+        throw std::invalid_argument("ResultReader::read: the box does not fit the data or the buffers");
+    }
+    try {
+        verify_tiles(box);
+        return read_checked(box, counts, outcomes);
+    } catch (const h5::Error& e) {
+        throw FormatError(path_.string() + " cannot be read: " + e.what() + "; the file is damaged");
+    }
+}
+
+std::uint64_t ResultReader::read_checked(const Box& box, std::span<std::uint32_t> counts,
+                                         std::span<std::uint8_t> outcomes) const
+{
+    const std::vector<hsize_t> start = to_hsize(box.start), count = to_hsize(box.count);
+    const h5::Id memory = h5::simple_space(count);
+    for (const hid_t d : {counts_.get(), outcomes_.get()}) {
+        const h5::Id space = h5::space_id(H5Dget_space(d), "H5Dget_space");
+        h5::select_box(space, start, count);
+        if (d == counts_.get()) {
+            h5::check(H5Dread(d, H5T_NATIVE_UINT32, memory, space, H5P_DEFAULT, counts.data()), "read /wall_bounces");
+        } else {
+            h5::check(H5Dread(d, H5T_NATIVE_UINT8, memory, space, H5P_DEFAULT, outcomes.data()), "read /outcome");
+        }
+    }
+    // Points of tiles not done hold whatever the disk held: mask them, a run of a row at a
+    // time (a row of the box crosses a tile every tile_shape.back() points).
+    std::vector<std::uint8_t> computed;
+    std::uint64_t missing = 0;
+    if (info_.kind == FileKind::partial && info_.tiles_done < info_.tiles) {
+        const std::size_t d = box.count.size();
+        computed.assign(box.points(), 1);
+        Extent per_axis(d);
+        for (std::size_t k = 0; k < d; ++k) per_axis[k] = (info_.shape[k] + info_.tile_shape[k] - 1) / info_.tile_shape[k];
+        const std::uint64_t row = box.count[d - 1], width = info_.tile_shape[d - 1];
+        Extent index(d, 0);
+        for (std::uint64_t p = 0; p < box.points(); p += row) {
+            std::uint64_t prefix = 0;  // the tile's index without its last coordinate
+            for (std::size_t k = 0; k + 1 < d; ++k) prefix = prefix * per_axis[k] + (box.start[k] + index[k]) / info_.tile_shape[k];
+            for (std::uint64_t j = 0; j < row;) {
+                const std::uint64_t column = box.start[d - 1] + j;
+                const std::uint64_t end = std::min(row, j + width - column % width);
+                if (done_[prefix * per_axis[d - 1] + column / width] == 0) {
+                    std::fill(computed.begin() + static_cast<std::ptrdiff_t>(p + j), computed.begin() + static_cast<std::ptrdiff_t>(p + end), 0);
+                    std::fill(counts.begin() + static_cast<std::ptrdiff_t>(p + j), counts.begin() + static_cast<std::ptrdiff_t>(p + end), 0u);
+                    std::fill(outcomes.begin() + static_cast<std::ptrdiff_t>(p + j), outcomes.begin() + static_cast<std::ptrdiff_t>(p + end), 0);
+                    missing += end - j;
+                }
+                j = end;
+            }
+            for (std::size_t k = d - 1; k-- > 0;) {
+                if (++index[k] < box.count[k]) break;
+                index[k] = 0;
+            }
+        }
+    }
+    validate_values(box, counts, outcomes, computed);
+    return missing;
+}
+
+void ResultReader::validate_values(const Box& box, std::span<const std::uint32_t> counts,
+                                   std::span<const std::uint8_t> outcomes, std::span<const std::uint8_t> computed) const
+{
+    const auto max = static_cast<std::uint64_t>(info_.max_bounces);
+    for (std::size_t p = 0; p < outcomes.size(); ++p) {
+        if (!computed.empty() && computed[p] == 0) continue;
+        const std::uint8_t o = outcomes[p];
+        const std::uint32_t n = counts[p];
+        const bool bad_outcome = o > 3;
+        const bool bad_count = o == 0 ? n != 0 : o == 3 ? n != max : n > max;
+        if (!bad_outcome && !bad_count) continue;
+        // The point's index, for the message.
+        Extent at(box.count.size());
+        std::uint64_t rest = p;
+        for (std::size_t k = box.count.size(); k-- > 0;) {
+            at[k] = box.start[k] + rest % box.count[k];
+            rest /= box.count[k];
+        }
+        const std::string where = fmt::format("at ({})", fmt::join(at, ", "));
+        if (bad_outcome) {
+            throw FormatError(fmt::format("{}: /outcome holds {} {}: outcome codes are 0 to 3 ({}); the file is damaged",
+                                          path_.string(), o, where, layout::outcome_meanings));
+        }
+        throw FormatError(fmt::format("{}: /wall_bounces holds {} {} with outcome {} ({}), which allows {}; the file is damaged",
+                                      path_.string(), n, where, o, o == 0 ? "invalid" : o == 3 ? "capped" : o == 1 ? "left" : "missed",
+                                      o == 0 ? std::string("0") : o == 3 ? fmt::format("exactly max_bounces = {}", max)
+                                                                         : fmt::format("at most max_bounces = {}", max)));
+    }
+}
+
+OutcomeCounts ResultReader::outcome_counts() const
+{
+    OutcomeCounts out;
+    std::vector<std::uint32_t> counts;
+    std::vector<std::uint8_t> outcomes;
+    const auto add = [&](const Box& box) {
+        counts.resize(box.points());
+        outcomes.resize(box.points());
+        read(box, counts, outcomes);
+        for (const std::uint8_t o : outcomes) ++out.by_outcome[o];
+    };
+    if (info_.kind == FileKind::partial) {
+        // Only the tiles done: an interrupted run of 10^10 points may have done few.
+        std::uint64_t computed = 0;
+        for (std::uint64_t t = 0; t < info_.tiles; ++t) {
+            if (done_[t] == 0) continue;
+            const Box box = tiling_->box(t);
+            add(box);
+            computed += box.points();
+        }
+        out.not_computed = info_.points() - computed;
+        return out;
+    }
+    // A result: about 16 Mi points at a time.
+    for_each_block(info_.shape, std::uint64_t{1} << 24, add);
+    return out;
+}
+
+void for_each_block(const Extent& shape, std::uint64_t max_points, const std::function<void(const Box&)>& f)
+{
+    const std::size_t d = shape.size();
+    max_points = std::max<std::uint64_t>(1, max_points);
+    // Trailing axes whole while they fit, then runs along the next one, leading axes one
+    // index at a time: blocks in storage order.
+    std::size_t cut = d;
+    std::uint64_t whole = 1;
+    while (cut > 0 && whole * shape[cut - 1] <= max_points) whole *= shape[--cut];
+    if (cut == 0) {
+        f(Box{Extent(d, 0), shape});
+        return;
+    }
+    const std::size_t axis = cut - 1;
+    const std::uint64_t run = std::max<std::uint64_t>(1, max_points / whole);
+    Box box{Extent(d, 0), shape};
+    for (std::size_t k = 0; k < axis; ++k) box.count[k] = 1;
+    for (;;) {
+        for (std::uint64_t first = 0; first < shape[axis]; first += run) {
+            box.start[axis] = first;
+            box.count[axis] = std::min(run, shape[axis] - first);
+            f(box);
+        }
+        std::size_t k = axis;
+        while (k-- > 0) {
+            if (++box.start[k] < shape[k]) break;
+            box.start[k] = 0;
+        }
+        if (k == static_cast<std::size_t>(-1)) return;
+    }
+}
+
+}  // namespace superball

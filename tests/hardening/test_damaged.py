@@ -1,0 +1,621 @@
+#!/usr/bin/python3
+"""Damaged files, read by every reader: a table of damages applied one at a time (with
+h5py or raw bytes) to a real result and a real partial file made by the binary. For each,
+`superball info`, `superball analyse` and the analysis scripts (region_map.py,
+summary.py) exit 2 with one line that names the file and the object (never a crash, a
+traceback or a hang); and `explore --resume` onto a damaged partial file is refused with
+the file left byte for byte. Then the writer's side: `explore --overwrite` replaces
+superball's files only.
+
+Run by ctest under the release build and, in the asan stage of tests/run, with the
+binary built with AddressSanitizer (a report there exits 86, which no case expects).
+Environment: SUPERBALL (the binary), SUPERBALL_SOURCE_DIR (for analysis/)."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+from concurrent.futures import ThreadPoolExecutor
+
+import h5py
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import SOURCE, interrupted_run, mpi_env, superball_binary, tile_boxes, tile_checksum  # noqa: E402
+
+ANALYSIS = os.path.join(SOURCE, "analysis")
+PYTHON = os.environ.get("SUPERBALL_PYTHON") or "/usr/bin/python3"
+
+JOB = """[model]
+e = 0.9
+alpha = 0.9
+
+[grid]
+xi = { min = 0.0, max = 1.0, n = 40 }
+U = -1.0
+W = { min = -3.0, max = 3.0, n = 30 }
+
+[run]
+max_bounces = 1000
+tile_points = 400
+"""
+
+def singleton_env():
+    """The environment of one rank started without mpirun: Open MPI's UCX probing, useless
+    for one rank, cost half of a refused run's 0.5 s here (the ob1 and self transports: 0.3 s)."""
+    return {**mpi_env(), "OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self"}
+
+# Runs the analysis scripts' main() for many files in one Python process (matplotlib is
+# imported once, not once per case): each case's exit status and standard error, or
+# "traceback" with the traceback when an exception escapes the scripts' own handling.
+DRIVER = r"""
+import contextlib, io, json, sys, traceback
+sys.path.insert(0, sys.argv[1])
+import region_map, summary
+scripts = {"region_map.py": region_map, "summary.py": summary}
+results = []
+for script, args in json.load(sys.stdin):
+    module = scripts[script]
+    err, out = io.StringIO(), io.StringIO()
+    sys.argv = [script, *args]
+    status = None
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+        try:
+            module.run_script(module.main)
+        except SystemExit as e:
+            status = e.code
+        except BaseException:
+            status = "traceback"
+            err.write(traceback.format_exc())
+    results.append({"status": status, "stderr": err.getvalue()})
+json.dump(results, sys.stdout)
+"""
+
+
+def read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+# --- Damages: each a function of the damaged file's path ---------------------------------
+
+
+def with_file(change):
+    def damage(path):
+        with h5py.File(path, "r+") as f:
+            change(f)
+    return damage
+
+
+def set_attribute(name, value, obj="/"):
+    def change(f):
+        f[obj].attrs[name] = value
+    return with_file(change)
+
+
+def delete_attribute(name, obj="/"):
+    def change(f):
+        del f[obj].attrs[name]
+    return with_file(change)
+
+
+def replace_dataset(name, make):
+    """/name replaced by make(old values) (dtype and shape as it says), its dimension scales
+    attached again where the shape still allows, so that only what the row says differs."""
+    def change(f):
+        old = f[name][()]
+        del f[name]
+        data = np.asarray(make(old))
+        f.create_dataset(name, data=data)
+        if name in ("wall_bounces", "outcome"):
+            for k, axis in enumerate(f.attrs["axis_names"][:data.ndim]):
+                axis = axis.decode() if isinstance(axis, bytes) else axis
+                if data.shape[k] == f[axis].shape[0]:
+                    f[name].dims[k].attach_scale(f[axis])
+    return with_file(change)
+
+
+def write_values(name, index, value):
+    def change(f):
+        f[name][index] = value
+    return with_file(change)
+
+
+def truncate(fraction):
+    def damage(path):
+        os.truncate(path, int(os.path.getsize(path) * fraction))
+    return damage
+
+
+def flip(offset_of):
+    """Flips one bit of the byte at offset_of(path)."""
+    def damage(path):
+        offset = offset_of(path)
+        with open(path, "r+b") as f:
+            f.seek(offset)
+            byte = f.read(1)[0]
+            f.seek(offset)
+            f.write(bytes([byte ^ 0x10]))
+    return damage
+
+
+def after(marker, skip):
+    """The offset `skip` bytes after the first occurrence of `marker` in the file."""
+    return lambda path: read_bytes(path).index(marker) + skip
+
+
+def in_chunk(dataset, chunk, at=0.5):
+    """An offset inside the stored bytes of one chunk of a dataset."""
+    def offset(path):
+        with h5py.File(path, "r") as f:
+            info = f[dataset].id.get_chunk_info(chunk)
+        return info.byte_offset + int(info.size * at)
+    return offset
+
+
+def journal_offset(path):
+    """Where /progress/tile_done's flags lie in the file."""
+    with h5py.File(path, "r") as f:
+        return f["progress/tile_done"].id.get_offset()
+
+
+def contradicting_journal(f):
+    """The issue's case: a file that says it is a complete result while its journal records
+    1 of 4 tiles done."""
+    f.attrs["superball_file"] = "result"
+    f.attrs["complete"] = np.int64(1)
+    f["progress/tile_done"][...] = [1, 0, 0, 0]
+
+
+def forged_done_tile(value):
+    """Tile 0 (done) holding `value` as its outcomes, its checksum recomputed: only the values say it is wrong."""
+    def change(f):
+        box = tile_boxes(f["outcome"].shape, [int(t) for t in f.attrs["tile_shape"]])[0]
+        f["outcome"][box] = value
+        sums = f["progress/tile_checksum"][()]
+        sums[0] = tile_checksum(f["wall_bounces"], f["outcome"], 0, tuple(s.start for s in box))
+        f["progress/tile_checksum"][...] = sums
+    return with_file(change)
+
+
+def swap_scales(f):
+    """The scales of /wall_bounces's two dimensions attached the wrong way round."""
+    d = f["wall_bounces"]
+    d.dims[0].detach_scale(f["xi"])
+    d.dims[1].detach_scale(f["W"])
+    d.dims[0].attach_scale(f["W"])
+    d.dims[1].attach_scale(f["xi"])
+
+
+def make_empty(path):
+    open(path, "wb").close()
+
+
+def make_directory(path):
+    os.remove(path)
+    os.mkdir(path)
+
+
+def make_text(path):
+    with open(path, "w") as f:
+        f.write("\\documentclass{article}\n\\begin{document}\nBounces.\n\\end{document}\n")
+
+
+def not_superball_hdf5(path):
+    os.remove(path)
+    with h5py.File(path, "w") as f:
+        f.create_dataset("temperature", data=np.arange(10.0))
+
+
+def dimension_list_as_text(f):
+    del f["wall_bounces"].attrs["DIMENSION_LIST"]
+    f["wall_bounces"].attrs["DIMENSION_LIST"] = "xi W"
+
+
+# (what, base file, damage, texts of which the message must contain one): the object the
+# message names. R: a complete result; P: the partial file of an interrupted run (tiles 0
+# and 2 of 4 done).
+REQUIRED = ["superball_file", "superball_format", "coordinate_system", "axis_names", "e_wall", "alpha_wall", "e_floor",
+            "alpha_floor", "fixed_U", "max_bounces", "software_version", "job_toml", "job_fingerprint", "mpi_ranks",
+            "wall_seconds", "complete"]
+CASES = [
+    # Wrong types of the data.
+    ("float counts", "R", replace_dataset("wall_bounces", lambda v: v.astype(np.float32)), "/wall_bounces holds"),
+    ("signed counts", "R", replace_dataset("wall_bounces", lambda v: v.astype(np.int16)), "/wall_bounces holds"),
+    ("64-bit outcomes", "R", replace_dataset("outcome", lambda v: v.astype(np.uint64)), "/outcome holds"),
+    ("signed outcomes", "R", replace_dataset("outcome", lambda v: v.astype(np.int8)), "/outcome holds"),
+    ("float counts in a partial file", "P", replace_dataset("wall_bounces", lambda v: v.astype(np.float64)),
+     "/wall_bounces holds"),
+    ("big-endian counts in a partial file", "P", replace_dataset("wall_bounces", lambda v: v.astype(">u2")),
+     "/wall_bounces holds"),
+    ("integer samples", "R", replace_dataset("xi", lambda v: np.arange(len(v))), "/xi holds"),
+    # Wrong shapes.
+    ("outcome of another shape", "R", replace_dataset("outcome", lambda v: v[:, :-1]), "/outcome (40, 29)"),
+    ("a coordinate of the wrong length", "R", replace_dataset("W", lambda v: v[:-1]), "/W holds"),
+    ("0-sized dimension", "R", with_file(lambda f: [f.__delitem__(n) for n in ("wall_bounces", "outcome")] and [
+        f.create_dataset(n, shape=(0, 30), dtype=t) for n, t in (("wall_bounces", np.uint16), ("outcome", np.uint8))]),
+     "is empty"),
+    ("3-D counts for 2 axes", "R", replace_dataset("wall_bounces", lambda v: v[:, :, None]), "/wall_bounces has 3"),
+    ("scalar counts", "R", replace_dataset("wall_bounces", lambda v: np.uint16(1)), "/wall_bounces"),
+    ("journal of the wrong length", "P", replace_dataset("progress/tile_done", lambda v: v[:-1]),
+     "/progress/tile_done holds"),
+    ("tile_shape contradicting the chunks", "P", set_attribute("tile_shape", np.array([10, 15], np.uint64)),
+     "/wall_bounces is stored in chunks of (20, 15)"),
+    ("tile_shape of 3 entries", "P", set_attribute("tile_shape", np.array([20, 15, 1], np.uint64)),
+     "attribute tile_shape lists 3"),
+    ("tile_shape larger than the grid", "P", set_attribute("tile_shape", np.array([20, 99], np.uint64)),
+     "attribute tile_shape = (20, 99)"),
+    ("tile_shape signed", "P", set_attribute("tile_shape", np.array([20, -15], np.int64)), "attribute tile_shape"),
+    # Attributes missing, each required one in turn.
+    *[(f"no {name}", "R", delete_attribute(name), f"attribute {name} is missing") for name in REQUIRED],
+    ("no tile_shape", "P", delete_attribute("tile_shape"), "attribute tile_shape is missing"),
+    # Attributes of the wrong type or shape.
+    ("text for a number", "R", set_attribute("max_bounces", "1000"), "attribute max_bounces is a text, not an integer"),
+    ("number for a text", "R", set_attribute("coordinate_system", np.int64(7)),
+     "attribute coordinate_system is an integer, not a text"),
+    ("float for an integer", "R", set_attribute("complete", 1.0), "attribute complete is a floating-point number"),
+    ("list for a scalar", "R", set_attribute("complete", np.array([1, 1], np.int64)),
+     "attribute complete is a list of 2 integers"),
+    ("one-element list for a scalar", "R", set_attribute("max_bounces", np.array([1000], np.int64)),
+     "attribute max_bounces is a list of 1 integers"),
+    ("list of numbers for texts", "R", set_attribute("axis_names", np.array([1.0, 2.0])),
+     "attribute axis_names is a list of 2 floating-point numbers"),
+    ("text of absurd length", "R", set_attribute("job_toml", "x" * (2 << 20)), "attribute job_toml holds a text of"),
+    ("fixed-length text of absurd length", "R", set_attribute("software_version", np.bytes_(b"v" * 100000)),
+     "attribute software_version holds a text of 100000 bytes"),
+    # Attributes that contradict each other or the layout.
+    ("a result with complete = 0", "R", set_attribute("complete", np.int64(0)), "contradicts superball_file = result"),
+    ("a partial file with complete = 1", "P", set_attribute("complete", np.int64(1)),
+     "contradicts superball_file = partial"),
+    ("complete result, journal 1 of 4 tiles", "P", with_file(contradicting_journal), "recording 1 of 4 tiles done"),
+    ("unknown kind", "R", set_attribute("superball_file", "draft"), 'superball_file = "draft"'),
+    ("another format", "R", set_attribute("superball_format", np.int64(3)), "superball_format = 3"),
+    ("unknown coordinate_system", "R", set_attribute("coordinate_system", "polar"), 'coordinate_system = "polar"'),
+    ("control characters in a text", "R", set_attribute("superball_file", "\x1b[2Jresult"),
+     'superball_file = "\\x1b[2Jresult"'),
+    ("axis_names = 'nonsense,,,'", "R", set_attribute("axis_names", "nonsense,,,"),
+     "attribute axis_names is a text, not a list of texts"),
+    ("axis_names naming an unknown axis", "R", set_attribute("axis_names", ["xi", "bogus"]), 'names "bogus"'),
+    ("axis_names naming an axis twice", "R", set_attribute("axis_names", ["xi", "xi"]), 'names "xi" twice'),
+    ("axis_names naming too many axes", "R", set_attribute("axis_names", ["e", "alpha", "xi", "U", "W"]),
+     "attribute axis_names lists 5 items"),
+    ("axis_names out of order", "R", set_attribute("axis_names", ["W", "xi"]), "out of order"),
+    ("axis_names naming a fixed coordinate", "R", set_attribute("axis_names", ["xi", "U"]),
+     "attribute fixed_W is missing"),
+    ("coefficient out of range", "R", set_attribute("e_wall", 1.5), "attribute e_wall = 1.5"),
+    ("coefficient naming no axis", "R", set_attribute("alpha_floor", "axis:alpha"), "attribute alpha_floor"),
+    ("NaN wall_seconds", "R", set_attribute("wall_seconds", float("nan")), "attribute wall_seconds"),
+    ("max_bounces 0", "R", set_attribute("max_bounces", np.int64(0)), "attribute max_bounces = 0"),
+    ("max_bounces beyond 16-bit counts", "R", set_attribute("max_bounces", np.int64(70000)), "16-bit counts"),
+    ("fixed_U contradicting /U", "R", set_attribute("fixed_U", -2.0), "contradicts attribute fixed_U"),
+    ("scales swapped", "R", with_file(swap_scales), "is not attached to dimension 0 of /wall_bounces"),
+    ("not a dimension scale", "R", delete_attribute("CLASS", "xi"), "/xi is not a dimension scale"),
+    ("DIMENSION_LIST a text", "R", with_file(dimension_list_as_text), "DIMENSION_LIST"),
+    ("coordinate variable deleted", "R", with_file(lambda f: f.__delitem__("W")), "/W is missing"),
+    ("outcome deleted", "R", with_file(lambda f: f.__delitem__("outcome")), "/outcome is missing"),
+    ("checksums deleted", "P", with_file(lambda f: f.__delitem__("progress/tile_checksum")),
+     "/progress/tile_checksum is missing"),
+    # Values out of range.
+    ("outcome 200 everywhere", "R", write_values("outcome", (), 200), "/outcome holds 200 at (0, 0)"),
+    ("outcome 4 at one point", "R", write_values("outcome", (17, 3), 4), "/outcome holds 4 at (17, 3)"),
+    ("counts of an invalid point", "R", with_file(lambda f: (f["outcome"].__setitem__((5, 6), 0),
+                                                              f["wall_bounces"].__setitem__((5, 6), 3))),
+     "/wall_bounces holds 3 at (5, 6) with outcome 0"),
+    ("capped below max_bounces", "R", with_file(lambda f: (f["outcome"].__setitem__((8, 1), 3),
+                                                            f["wall_bounces"].__setitem__((8, 1), 999))),
+     "/wall_bounces holds 999 at (8, 1) with outcome 3"),
+    ("count above max_bounces", "R", with_file(lambda f: (f["outcome"].__setitem__((9, 9), 1),
+                                                           f["wall_bounces"].__setitem__((9, 9), 4000))),
+     "/wall_bounces holds 4000 at (9, 9)"),
+    ("journal flag 2", "P", write_values("progress/tile_done", 1, 2), "/progress/tile_done holds 2 for tile 1"),
+    ("a done tile changed", "P", write_values("wall_bounces", (3, 4), 777), "tile 0 (xi 0..19, W 0..14)"),
+    ("a done tile forged, checksum recomputed", "P", forged_done_tile(200), "/outcome holds 200 at (0, 0)"),
+    ("coordinates not increasing", "R", replace_dataset("xi", lambda v: v[[0, 2, 1, *range(3, len(v))]]),
+     "/xi is not increasing at 2"),
+    ("coordinate NaN", "R", replace_dataset("W", lambda v: np.where(np.arange(len(v)) == 4, np.nan, v)),
+     "/W holds nan at 4"),
+    ("fixed coordinate not a scalar", "R", replace_dataset("U", lambda v: np.array([v])), "/U holds a list of 1"),
+    # Truncated files.
+    *[(f"truncated to {fraction:g}", base, truncate(fraction), "truncated")
+      for base in "RP" for fraction in (0.001, 0.1, 0.5, 0.9, 0.999)],
+    # One bit flipped: HDF5's metadata checksums, the deflate stream's, the tiles'.
+    ("bit flip in the signature", "R", flip(lambda p: 1), "not a superball result"),
+    ("bit flip in the superblock", "R", flip(lambda p: 20), ("superblock", "damaged", "truncated")),
+    ("bit flip in the root object header", "R", flip(after(b"OHDR", 12)), ("damaged", "object header")),
+    ("bit flip in the root object header", "P", flip(after(b"OHDR", 12)), ("damaged", "object header")),
+    ("bit flip in an attribute's name", "R", flip(after(b"superball_file", 3)), ("superball_file", "damaged")),
+    ("bit flip in the attribute heap", "P", flip(after(b"FRHP", 40)), ("damaged", "attribute")),
+    # HDF5 trusts the sizes of the objects of its global heap (texts, DIMENSION_LIST): these
+    # crashed libhdf5 1.10.8 itself (h5py too) before the readers walked the heap first.
+    ("bit flip in a global heap object's size", "R", flip(after(b"GCOL", 16 + 8 + 1)), "the global heap at byte"),
+    ("bit flip in a global heap object's size", "P", flip(after(b"GCOL", 16 + 8 + 1)), "the global heap at byte"),
+    ("bit flip in the global heap's size", "R", flip(after(b"GCOL", 9)), "the global heap at byte"),
+    ("bit flip in compressed counts", "R", flip(in_chunk("wall_bounces", 0)), "/wall_bounces"),
+    ("bit flip in compressed outcomes", "R", flip(in_chunk("outcome", 0, 0.3)), "/outcome"),
+    ("bit flip in a done tile", "P", flip(in_chunk("outcome", 2, 0.6)), "tile 2 (xi 20..39, W 0..14)"),
+    ("bit flip in the journal", "P", flip(lambda p: journal_offset(p) + 1),
+     "/progress/tile_done holds 16 for tile 1"),
+    # Not a superball file at all.
+    ("a 0-byte file", "R", make_empty, "is an empty file"),
+    ("a directory", "R", make_directory, "is a directory"),
+    ("a text file", "R", make_text, "is a text file of"),
+    ("another program's HDF5 file", "R", not_superball_hdf5, "not a superball result"),
+    ("a 0-byte partial file", "P", make_empty, "is an empty file"),
+    ("a directory as the partial file", "P", make_directory, "is a directory"),
+    ("a text file as the partial file", "P", make_text, "is a text file of"),
+]
+
+
+class Damaged(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.binary = superball_binary()
+        cls.dir = tempfile.mkdtemp(prefix="superball-damaged-")
+        cls.job = os.path.join(cls.dir, "job.toml")
+        with open(cls.job, "w") as f:
+            f.write(JOB)
+        cls.result = os.path.join(cls.dir, "result.h5")
+        r = subprocess.run([cls.binary, "explore", cls.job, "-o", cls.result, "-q"], capture_output=True, text=True,
+                           env=mpi_env(), timeout=120)
+        assert r.returncode == 0, r.stderr
+        cls.partial = interrupted_run(cls.binary, cls.job, os.path.join(cls.dir, "interrupted.h5"), cls.result,
+                                      lambda t: t % 2 == 0)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def run_binary(self, *args):
+        return subprocess.run([self.binary, *args], capture_output=True, text=True, env=singleton_env(), timeout=60)
+
+    def damaged_copies(self, cases):
+        """Each case applied to a fresh copy of its base: the partial file of case i is
+        d<i>.h5.partial, so that `explore --resume -o d<i>.h5` finds it."""
+        files = []
+        for i, (what, base, damage, _) in enumerate(cases):
+            out = os.path.join(self.dir, f"d{i}.h5")
+            path = out + ".partial" if base == "P" else out
+            shutil.copyfile(self.partial if base == "P" else self.result, path)
+            damage(path)
+            files.append((out, path))
+        return files
+
+    def assert_one_message(self, what, who, status, stderr, expected, path):
+        self.assertNotEqual(status, "traceback", f"{what}: {who} raised:\n{stderr}")
+        self.assertEqual(status, 2, f"{what}: {who} exit status {status}:\n{stderr}")
+        lines = stderr.strip().splitlines()
+        self.assertEqual(len(lines), 1, f"{what}: {who} said more than one line:\n{stderr}")
+        self.assertIn(path, lines[0], f"{what}: {who} does not name the file")
+        alternatives = (expected,) if isinstance(expected, str) else expected
+        self.assertTrue(any(e in lines[0] for e in alternatives), f"{what}: {who} said {lines[0]!r}, not {expected!r}")
+
+    def test_every_reader_refuses_every_damage(self):
+        files = self.damaged_copies(CASES)
+        before = {path: read_bytes(path) if os.path.isfile(path) else None for _, path in files}
+        # The scripts, all cases in one Python process.
+        requests = []
+        for _, path in files:
+            requests += [["summary.py", [path]], ["region_map.py", [path, "-o", path + ".png"]]]
+        driver = subprocess.run([PYTHON, "-c", DRIVER, ANALYSIS], input=json.dumps(requests), capture_output=True,
+                                text=True, timeout=300)
+        self.assertEqual(driver.returncode, 0, f"the analysis scripts crashed: {driver.stderr}")
+        scripts = json.loads(driver.stdout)
+
+        def binary_runs(i):
+            out, path = files[i]
+            runs = [("superball info", self.run_binary("info", path)), ("superball analyse", self.run_binary("analyse", path))]
+            if CASES[i][1] == "P" and "forged" not in CASES[i][0]:
+                # A tile forged with a matching checksum passes for computed: resume trusts
+                # checksums, not values (the readers check those).
+                runs.append(("explore --resume", self.run_binary("explore", self.job, "-o", out, "--resume", "-q")))
+            return runs
+
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            binary = list(pool.map(binary_runs, range(len(CASES))))
+        for i, (what, base, _, expected) in enumerate(CASES):
+            out, path = files[i]
+            with self.subTest(what, base=base):
+                for (name, run) in binary[i]:
+                    self.assertNotIn("AddressSanitizer", run.stderr)
+                    self.assertNotIn("runtime error", run.stderr)
+                    self.assertEqual(run.stdout if name != "explore --resume" else "", "", f"{what}: {name} printed")
+                    if name == "explore --resume":
+                        self.assertEqual(run.returncode, 2, f"{what}: {name}: {run.stderr}")
+                        self.assertEqual(run.stderr.count("superball explore:"), 1, run.stderr)
+                        self.assertIn(path, run.stderr)
+                        self.assertFalse(os.path.exists(out), f"{what}: {name} wrote a result")
+                    else:
+                        self.assert_one_message(what, name, run.returncode, run.stderr, expected, path)
+                for k, script in enumerate(("summary.py", "region_map.py")):
+                    r = scripts[2 * i + k]
+                    self.assert_one_message(what, script, r["status"], r["stderr"], expected, path)
+                if before[path] is not None:
+                    self.assertEqual(read_bytes(path), before[path], f"{what}: a reader changed the file")
+                elif base == "P" and what == "a directory as the partial file":
+                    self.assertEqual(os.listdir(path), [])
+
+    def test_scripts_as_a_user_runs_them(self):
+        """The table runs the scripts' main() in one process; here each runs as a command."""
+        ((out, path),) = self.damaged_copies([("", "R", write_values("outcome", (2, 3), 9), "")])
+        for script in ("summary.py", "region_map.py"):
+            r = subprocess.run([PYTHON, os.path.join(ANALYSIS, script), path], capture_output=True, text=True,
+                               timeout=120)
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertEqual(r.stderr.strip(), f"{script}: error: {path}: /outcome holds 9 at (2, 3): outcome codes "
+                                                "are 0 to 3 (invalid left missed capped); the file is damaged")
+
+    def test_one_byte_overwritten_anywhere(self):
+        """A byte overwritten at offsets across each file: every reader either reads the
+        file (the byte was in space no object uses, or a tile not done) or refuses it with
+        exit 2; never a crash, a traceback or a hang."""
+        cases = []
+        for base, source in (("R", self.result), ("P", self.partial)):
+            size = os.path.getsize(source)
+            for offset in np.linspace(0, size - 1, 24).astype(int):
+                def damage(path, offset=int(offset)):
+                    with open(path, "r+b") as f:
+                        f.seek(offset)
+                        byte = f.read(1)[0]
+                        f.seek(offset)
+                        f.write(bytes([byte ^ 0xA5]))
+                cases.append((f"byte {offset} of {base}", base, damage, ""))
+        files = self.damaged_copies(cases)
+        requests = [["summary.py", [path]] for _, path in files]
+        driver = subprocess.run([PYTHON, "-c", DRIVER, ANALYSIS], input=json.dumps(requests), capture_output=True,
+                                text=True, timeout=300)
+        self.assertEqual(driver.returncode, 0, driver.stderr)
+        refused = 0
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            infos = list(pool.map(lambda f: self.run_binary("info", f[1]), files))
+        for (what, *_), r, s in zip(cases, infos, json.loads(driver.stdout)):
+            with self.subTest(what):
+                self.assertIn(r.returncode, (0, 2), r.stderr)
+                self.assertIn(s["status"], (0, 2), s["stderr"])
+                if r.returncode == 2:
+                    refused += 1
+                    self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+        self.assertGreater(refused, len(cases) // 3)
+
+
+class Overwrite(unittest.TestCase):
+    """`explore --overwrite` replaces superball's files only; everything else is refused
+    with a message that says what the file is, and left byte for byte."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.binary = superball_binary()
+        cls.dir = tempfile.mkdtemp(prefix="superball-overwrite-")
+        cls.job = os.path.join(cls.dir, "job.toml")
+        with open(cls.job, "w") as f:
+            f.write(JOB)
+        cls.result = os.path.join(cls.dir, "result.h5")
+        assert cls.explore(cls, cls.result).returncode == 0
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def explore(self, out, *flags):
+        return subprocess.run([self.binary, "explore", self.job, "-o", out, "-q", *flags], capture_output=True, text=True,
+                              env=singleton_env(), timeout=120)
+
+    def path(self, name):
+        p = os.path.join(self.dir, name)
+        for q in (p, p + ".partial", p + ".finishing"):
+            if os.path.isdir(q):
+                shutil.rmtree(q)
+            elif os.path.exists(q):
+                os.remove(q)
+        return p
+
+    def assert_refused(self, out, victim, flags, *needles):
+        """Refused (exit 2, one message naming the file and saying what it is), the file left as it was."""
+        before = read_bytes(victim) if os.path.isfile(victim) else None
+        r = self.explore(out, *flags)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+        self.assertIn(victim, r.stderr)
+        for needle in needles:
+            self.assertIn(needle, r.stderr)
+        if before is not None:
+            self.assertEqual(read_bytes(victim), before, "a refused run changed the file")
+        self.assertFalse(os.path.exists(out + ".partial") and victim != out + ".partial", "a refused run left a partial file")
+        return r
+
+    def assert_valid_result(self, out):
+        r = subprocess.run([self.binary, "info", out], capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("complete:    yes", r.stdout)
+
+    def test_a_text_file_is_never_replaced(self):
+        thesis = self.path("thesis.tex")
+        make_text(thesis)
+        size = os.path.getsize(thesis)
+        r = self.assert_refused(thesis, thesis, ["--overwrite"], f"is a text file of {size} bytes, beginning",
+                                "\\documentclass{article}", "not a superball file", "even with --overwrite")
+        r = self.assert_refused(thesis, thesis, [], "is a text file", "not a superball file")
+        self.assertNotIn("--overwrite", r.stderr)
+        self.assert_refused(thesis, thesis, ["--resume"], "is a text file")
+
+    def test_other_things_at_the_output_are_never_replaced(self):
+        for what, make, needle in (("an empty file", make_empty, "is an empty file"),
+                                   ("another program's HDF5 file", not_superball_hdf5, "an HDF5 file that is not superball's")):
+            with self.subTest(what):
+                out = self.path("other.h5")
+                open(out, "w").close()
+                make(out)
+                self.assert_refused(out, out, ["--overwrite"], needle)
+                r = self.assert_refused(out, out, [], needle)
+                self.assertNotIn("--overwrite", r.stderr)
+        directory = self.path("a-directory.h5")
+        os.mkdir(directory)
+        self.assert_refused(directory, directory, ["--overwrite"], "is a directory")
+        self.assertTrue(os.path.isdir(directory))
+
+    def test_the_partial_file_is_never_replaced_unless_it_is_superballs(self):
+        out = self.path("p.h5")
+        for what, make, needle in (("a text file", make_text, "is a text file"),
+                                   ("another program's HDF5 file", not_superball_hdf5, "not superball's"),
+                                   ("a directory", make_directory, "is a directory")):
+            with self.subTest(what):
+                partial = out + ".partial"
+                if os.path.isdir(partial):
+                    os.rmdir(partial)
+                open(partial, "w").close()
+                make(partial)
+                for flags in (["--overwrite"], ["--resume"], []):
+                    r = self.assert_refused(out, partial, flags, needle, "where this output's run keeps its tiles")
+                    if "--overwrite" not in flags:
+                        self.assertNotIn("--overwrite", r.stderr)
+                self.assertFalse(os.path.exists(out))
+        shutil.rmtree(out + ".partial")
+
+    def test_damaged_superball_files_are_replaced_with_overwrite(self):
+        """A result or partial file that cannot be read, but is superball's, is refused
+        without --overwrite (which the message suggests) and replaced with it."""
+        partial_source = interrupted_run(self.binary, self.job, self.path("source.h5"), self.result, lambda t: t == 0)
+        cases = [
+            ("truncated result", "R", truncate(0.5)),
+            ("result with outcome 200", "R", write_values("outcome", (), 200)),
+            ("result with a bit flipped in its root object header", "R", flip(after(b"OHDR", 12))),
+            ("truncated partial file", "P", truncate(0.5)),
+            ("partial file with a damaged done tile", "P", write_values("wall_bounces", (1, 1), 777)),
+            ("partial file whose journal contradicts it", "P", with_file(contradicting_journal)),
+        ]
+        for what, base, damage in cases:
+            with self.subTest(what):
+                out = self.path("damaged.h5")
+                victim = out + ".partial" if base == "P" else out
+                shutil.copyfile(partial_source if base == "P" else self.result, victim)
+                damage(victim)
+                r = self.assert_refused(out, victim, [] if base == "R" else ["--resume"], "--overwrite")
+                r = self.explore(out, "--overwrite")
+                self.assertEqual(r.returncode, 0, r.stderr)
+                self.assert_valid_result(out)
+                self.assertFalse(os.path.exists(out + ".partial"))
+
+    def test_files_the_run_writes_beside_the_result(self):
+        out = self.path("beside.h5")
+        finishing, sidecar = out + ".finishing", os.path.join(self.dir, "beside.xmf")
+        make_text(finishing)
+        r = self.assert_refused(out, finishing, ["--overwrite"], "is a text file", "before it takes its name")
+        os.remove(finishing)
+        with open(sidecar, "w") as f:
+            f.write("my own notes\n")
+        self.assert_refused(out, sidecar, [], "is a text file", "ParaView sidecar")
+        os.remove(sidecar)
+        # A sidecar superball wrote is its own: replaced.
+        self.assertEqual(self.explore(out).returncode, 0)
+        self.assertEqual(self.explore(out, "--overwrite").returncode, 0, r.stderr)
+        self.assert_valid_result(out)
+        # A result named like its own sidecar gets none: it is no foreign sidecar of itself.
+        named_xmf = self.path("r.xmf")
+        self.assertEqual(self.explore(named_xmf).returncode, 0)
+        self.assertEqual(self.explore(named_xmf, "--overwrite").returncode, 0)
+        self.assert_valid_result(named_xmf)
+
+
+if __name__ == "__main__":
+    unittest.main()
