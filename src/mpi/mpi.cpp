@@ -28,6 +28,7 @@ bool sets_key(std::string_view params, std::string_view key)
     return false;
 }
 
+#ifdef OPEN_MPI  // only Open MPI reads it (SMPI, tests/scale, is another MPI)
 std::string user_mca_params(const Getenv& getenv)
 {
     const char* home = getenv("HOME");
@@ -35,6 +36,7 @@ std::string user_mca_params(const Getenv& getenv)
     std::ifstream in(std::string(home) + "/.openmpi/mca-params.conf");
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
+#endif
 
 }  // namespace
 

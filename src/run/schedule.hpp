@@ -64,6 +64,9 @@ struct ScheduleSettings {
     // Blocks are multiples of this many tiles where they can be (a stripe of the file
     // system's alignment, so that two ranks' writes do not share one).
     std::uint64_t granule = 1;
+    // A block is what is left over (block_divisor x ranks), per rank it serves (guided
+    // self-scheduling; at least one tile).
+    std::uint64_t block_divisor = 2;
     // With at least this many ranks, rank 0 computes no tile and only schedules (0:
     // never). Below it, a computing rank 0 loses little: it answers within a few hundred
     // points and its share of the work is 1/P; from about 64 ranks on its answers are

@@ -10,8 +10,10 @@
 #                     a 64^3 volume at max_bounces 20000 at -n 1 (mean 1548 bounces a point,
 #                     7.7 % of the points capped: the load of jobs/cluster), less the two
 #                     terms above;
-#   COMPRESS_MBPS     shuffle + deflate (h5repack -f SHUF -f GZIP=4, one core) of the raw
-#   COMPRESS_RATIO    data of jobs/full/volume.toml (512^3), MB/s and size ratio.
+#   COMPRESS_MBPS     the closing pass of `superball explore` at -n 1 (read back the raw
+#   COMPRESS_RATIO    data, shuffle + deflate, write the result) on jobs/full/volume.toml
+#                     (512^3): raw MB per second of "written in", and raw / result size
+#                     (simulate.sh takes each job's ratio from its low-resolution result).
 #
 # Each figure is the median of REPS (default 5) interleaved repetitions: this machine is
 # shared and a single run varies by +-25 %. Explore's own "computed in" time is used (the
@@ -48,38 +50,37 @@ computed() {  # the compute-phase seconds of one run at -n 1
 declare -A times
 for ((r = 0; r < reps; r++)); do
   for j in trivial_big trivial_small garwin; do times[$j]+="$(computed $j) "; done
-  echo "calibrate: repetition $((r + 1)) of $reps: ${times[trivial_big]##* } ${times[trivial_small]##* } ${times[garwin]##* }" >&2
+  echo "calibrate: repetition $((r + 1)) of $reps: ${times[trivial_big]} / ${times[trivial_small]} / ${times[garwin]}" >&2
 done
-mpirun -n 1 "$superball" explore jobs/full/volume.toml -o "$work/volume.h5" --overwrite -q >/dev/null 2>&1
 compress=""
 for ((r = 0; r < reps; r++)); do
-  start=$EPOCHREALTIME
-  h5repack -f SHUF -f GZIP=4 "$work/volume.h5" "$work/volume.gz.h5"
-  compress+="$(/usr/bin/python3 -c "print($EPOCHREALTIME - $start)") "
+  # "result: PATH (R MB, P% of the RAW MB of raw data; written in T s)"
+  compress+="$(mpirun -n 1 "$superball" explore jobs/full/volume.toml -o "$work/volume.h5" --overwrite 2>&1 |
+    sed -n 's/^result: .*(\([0-9.]*\) MB, .* of the \([0-9.]*\) MB of raw data; written in \([0-9.]*\) s).*/\3:\2:\1/p') "
 done
-
-/usr/bin/python3 - "$work" "${times[trivial_big]}" "${times[trivial_small]}" "${times[garwin]}" "$compress" <<'EOF' >tests/scale/calibration.env
+echo "calibrate: closing pass of jobs/full/volume.toml (s:raw MB:result MB): $compress" >&2
+garwin_tiles=$("$superball" explore "$work/garwin.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
+/usr/bin/python3 - "$work" "$garwin_tiles" "${times[trivial_big]}" "${times[trivial_small]}" "${times[garwin]}" "$compress" <<'EOF' >tests/scale/calibration.env
 import statistics, sys, h5py, numpy as np, datetime
-work, big, small, garwin, compress = sys.argv[1], *[[float(x) for x in a.split()] for a in sys.argv[2:]]
+work, garwin_tiles = sys.argv[1], int(sys.argv[2])
+big, small, garwin = [[float(x) for x in a.split()] for a in sys.argv[3:6]]
+closing = [[float(x) for x in c.split(":")] for c in sys.argv[6].split()]
+compress = [c[0] for c in closing]
+raw, packed = closing[0][1] * 1e6, closing[0][2] * 1e6
 med = statistics.median
 points = 8192 * 8192
 tiles_big, tiles_small = points // 262144, points // 1024
 us_per_tile = (med(small) - med(big)) / (tiles_small - tiles_big) * 1e6
+# Within the noise a tile can seem to cost nothing, never less.
+us_per_tile = max(us_per_tile, 0.0)
 ns_per_point = (med(big) - tiles_big * us_per_tile * 1e-6) / points * 1e9
 with h5py.File(f"{work}/garwin.h5") as f:
     n = f["wall_bounces"][()].astype(np.float64)
-    garwin_tiles = int(np.prod([-(-s // t) for s, t in zip(n.shape, f.attrs["tile_shape"])]))
 ns_per_iteration = (med(garwin) - n.size * ns_per_point * 1e-9 - garwin_tiles * us_per_tile * 1e-6) / n.sum() * 1e9
-raw = 0
-with h5py.File(f"{work}/volume.h5") as f:
-    for d in ("wall_bounces", "outcome"):
-        raw += f[d].size * f[d].dtype.itemsize
-with h5py.File(f"{work}/volume.gz.h5") as f:
-    packed = sum(f[d].id.get_storage_size() for d in ("wall_bounces", "outcome"))
 print(f"# Cost model of tests/scale/simulate.sh, measured by tests/scale/calibrate.sh on {datetime.date.today()}")
 print(f"# (medians of {len(big)} runs: trivial grid {med(big):.3f} s with 262144-point tiles, {med(small):.3f} s with")
-print(f"# 1024-point tiles; Garwin's ball 64^3 {med(garwin):.3f} s for {n.sum():.4g} bounces; h5repack {med(compress):.3f} s")
-print(f"# for {raw / 1e6:.1f} MB of jobs/full/volume.toml, {packed / 1e6:.2f} MB compressed).")
+print(f"# 1024-point tiles; Garwin's ball 64^3 {med(garwin):.3f} s for {n.sum():.4g} bounces; closing pass")
+print(f"# of jobs/full/volume.toml {med(compress):.3f} s for {raw / 1e6:.1f} MB raw, {packed / 1e6:.2f} MB compressed).")
 print(f"NS_PER_POINT={ns_per_point:.2f}")
 print(f"NS_PER_ITERATION={ns_per_iteration:.2f}")
 print(f"US_PER_TILE={us_per_tile:.2f}")

@@ -9,7 +9,8 @@
 // makes for RANKS ranks (default_tiling). OUT.bin: "SBCOST01", then u64 tiles, bytes
 // written per point, points; tiles doubles (seconds); tiles u64 (points); tiles u64 (the
 // pending tiles of a fresh run, in order: 0, 1, ...; shared by all simulated ranks). Prints one
-// line: tiles, total compute, the costliest tile, the ideal time at RANKS ranks.
+// line: tiles, the block granule, total compute, the costliest tile, the ideal time at
+// RANKS ranks.
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -116,6 +117,7 @@ int main(int argc, char** argv)
         if (low.shape.size() != tiling.shape().size()) {
             throw std::runtime_error(fmt::format("{} has {} axes, the job {}", argv[3], low.shape.size(), tiling.shape().size()));
         }
+        const std::uint64_t count_bytes = job.max_bounces > 65535 ? 4 : 2;  // /wall_bounces: uint16 or uint32
         std::vector<double> cost(tiling.tiles());
         std::vector<std::uint64_t> points(tiling.tiles());
         double total = 0;
@@ -130,14 +132,17 @@ int main(int argc, char** argv)
         std::ofstream out(argv[7], std::ios::binary);
         out.write("SBCOST01", 8);
         put(out, tiling.tiles());
-        put(out, static_cast<std::uint64_t>(job.max_bounces > 65535 ? 5 : 3));
+        put(out, count_bytes + 1);
         put(out, job.points());
         out.write(reinterpret_cast<const char*>(cost.data()), static_cast<std::streamsize>(cost.size() * sizeof(double)));
         out.write(reinterpret_cast<const char*>(points.data()), static_cast<std::streamsize>(points.size() * sizeof(std::uint64_t)));
         for (std::uint64_t t = 0; t < tiling.tiles(); ++t) put(out, t);
         if (!out) throw std::runtime_error(std::string("cannot write ") + argv[7]);
-        fmt::print("tiles={} tile_points={} compute_s={:.6g} costliest_tile_s={:.6g} ideal_s={:.6g}\n", tiling.tiles(),
-                   tiling.box(0).points(), total, worst, total / ranks);
+        // Blocks are multiples of this many tiles where they can be, as run_explore asks
+        // (one alignment unit of counts).
+        const std::uint64_t granule = std::max<std::uint64_t>(1, job.alignment / (tiling.box(0).points() * count_bytes));
+        fmt::print("tiles={} tile_points={} granule={} compute_s={:.6g} costliest_tile_s={:.6g} ideal_s={:.6g}\n",
+                   tiling.tiles(), tiling.box(0).points(), granule, total, worst, total / ranks);
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "scale_costs: %s\n", e.what());

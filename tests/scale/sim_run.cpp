@@ -1,15 +1,16 @@
 // The real schedule (src/run/schedule.cpp, over src/mpi/mpi.cpp) under SimGrid's SMPI,
 // with counting and writing replaced by cost models: a tile costs what scale_costs
 // computed from a real result of the job (smpi_execute), and the writer's flushes, rank
-// 0's resume journal and the closing compression pass cost what a shared file system of
-// the platform's bandwidth, plus a latency per operation, makes them (S4U disk I/O).
+// 0's resume journal and the closing compression pass cost what the platform's shared file
+// system makes them: its disk's bandwidth, shared by every operation in flight, after the
+// latency per operation the disk's property op_latency states (S4U disk I/O).
 // Built with smpicxx and run with smpirun by tests/scale/simulate.sh; prints one line of
 // key=value on rank 0.
 //
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
-//       [--report-seconds 1] [--granule 1] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
-//       [--fs-latency 1e-3] [--flush-bytes 8388608] [--journal-seconds 10]
-//       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--pieces 4]
+//       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
+//       [--flush-bytes 8388608] [--journal-seconds 10]
+//       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--serve-every 0.05] [--trace]
 #include <fcntl.h>
 #include <mpi.h>
 #include <smpi/smpi.h>
@@ -87,13 +88,13 @@ private:
 struct Options {
     std::string costs;
     ScheduleSettings schedule;
-    double fs_latency = 1e-3;      // per write or read operation (an RPC and a lock on Lustre)
     double flush_bytes = 8 << 20;  // the writer's buffer
     double journal_seconds = 10;
     double compress_mbps = 100;    // shuffle + deflate, per core
     double compress_ratio = 100;
     bool io = true;
-    std::uint64_t pieces = 4;      // most pieces a tile is computed in, where the rank serves no one
+    bool trace = false;            // one line per rank on standard error (where the tail comes from)
+    double serve_every = 0.05;     // most compute seconds between two Serve calls (see ModelWork)
 };
 
 Options parse(int argc, char** argv)
@@ -108,15 +109,16 @@ Options parse(int argc, char** argv)
         if (a == "--node-ranks") o.schedule.node_ranks = std::stoi(value());
         else if (a == "--report-seconds") o.schedule.report_seconds = std::stod(value());
         else if (a == "--granule") o.schedule.granule = std::stoull(value());
+        else if (a == "--block-divisor") o.schedule.block_divisor = std::stoull(value());
         else if (a == "--dedicated-root-ranks") o.schedule.dedicated_root_ranks = std::stoi(value());
         else if (a == "--idle-poll") o.schedule.idle_poll_seconds = std::stod(value());
-        else if (a == "--fs-latency") o.fs_latency = std::stod(value());
         else if (a == "--flush-bytes") o.flush_bytes = std::stod(value());
         else if (a == "--journal-seconds") o.journal_seconds = std::stod(value());
         else if (a == "--compress-mbps") o.compress_mbps = std::stod(value());
         else if (a == "--compress-ratio") o.compress_ratio = std::stod(value());
         else if (a == "--no-io") o.io = false;
-        else if (a == "--pieces") o.pieces = std::stoull(value());
+        else if (a == "--trace") o.trace = true;
+        else if (a == "--serve-every") o.serve_every = std::stod(value());
         else if (o.costs.empty() && a.rfind("--", 0) != 0) o.costs = a;
         else throw std::runtime_error("unknown argument " + a);
     }
@@ -125,15 +127,19 @@ Options parse(int argc, char** argv)
 }
 
 // The shared file system: the disk of the platform's host "fs", which every rank's
-// operations share (its bandwidth is the file system's aggregate), after a latency.
+// operations share (its bandwidth is the file system's aggregate), after the latency of an
+// operation (its property op_latency, in seconds: an RPC and a lock on Lustre).
 class FileSystem {
 public:
-    explicit FileSystem(const Options& o) : latency_(o.fs_latency), on_(o.io)
+    explicit FileSystem(const Options& o) : on_(o.io)
     {
         if (!on_) return;
         const auto disks = simgrid::s4u::Host::by_name("fs")->get_disks();
         if (disks.empty()) throw std::runtime_error("the platform's host fs has no disk");
         disk_ = disks.front();
+        const char* latency = disk_->get_property("op_latency");
+        if (!latency) throw std::runtime_error("the platform's disk of host fs states no op_latency");
+        latency_ = std::stod(latency);
     }
     void write(double bytes) { io(bytes, true); }
     void read(double bytes) { io(bytes, false); }
@@ -150,21 +156,23 @@ private:
         else disk_->read(n);
     }
 
-    double latency_;
+    double latency_ = 0;
     bool on_;
     simgrid::s4u::Disk* disk_ = nullptr;
 };
 
 // Counting replaced by smpi_execute of the tile's modelled cost, in pieces with the Serve
-// callback between them as the real counter calls it every 512 points (at most 8 pieces on
-// a rank that serves others, --pieces elsewhere, to keep the simulation's events few:
-// answers come later than in the real run, never sooner);
+// callback between them. The real counter calls it every 512 points; so does the model
+// where 512 points cost more than --serve-every seconds (a rank holding heavy tiles
+// answers requests for tiles back as late as the real one), and every --serve-every
+// seconds of compute elsewhere (fewer events: answers come later than in the real run by
+// at most that, never sooner);
 // writing by the writer's model: tiles buffered until ~8 MiB or a flush, then per run of
 // consecutive tiles one write to /wall_bounces and one to /outcome.
 class ModelWork final : public TileWork {
 public:
-    ModelWork(const Costs& c, FileSystem& fs, const Options& o, bool serves)
-        : costs_(c), fs_(fs), flush_bytes_(o.flush_bytes), serves_(serves), pieces_(o.pieces)
+    ModelWork(const Costs& c, FileSystem& fs, const Options& o)
+        : costs_(c), fs_(fs), flush_bytes_(o.flush_bytes), serve_every_(o.serve_every)
     {
     }
 
@@ -172,7 +180,8 @@ public:
     {
         const double cost = costs_.cost(tile);
         const std::uint64_t points = costs_.tile_points(tile);
-        const int pieces = static_cast<int>(std::clamp<std::uint64_t>(points / 512, 1, serves_ ? 8 : pieces_));
+        const auto wanted = static_cast<std::uint64_t>(std::ceil(cost / serve_every_));
+        const int pieces = static_cast<int>(std::clamp<std::uint64_t>(wanted, 1, std::max<std::uint64_t>(1, points / 512)));
         for (int i = 0; i < pieces; ++i) {
             smpi_execute(cost / pieces);
             if (serve) serve();
@@ -223,8 +232,7 @@ private:
     const Costs& costs_;
     FileSystem& fs_;
     double flush_bytes_;
-    bool serves_;
-    std::uint64_t pieces_;
+    double serve_every_;
     std::vector<std::pair<std::uint64_t, std::uint64_t>> runs_;  // [first, end) of consecutive tiles
     std::vector<std::uint64_t> run_points_;
     std::vector<std::uint64_t> buffered_;
@@ -242,8 +250,7 @@ int run(int argc, char** argv)
     // process (smpi/privatization:no, so this static is shared), one after the other.
     static const Costs costs(o.costs);
     FileSystem fs(o);
-    const int node = o.schedule.node_ranks > 0 ? o.schedule.node_ranks : 1;
-    ModelWork work(costs, fs, o, rank % node == 0);
+    ModelWork work(costs, fs, o);
 
     // Rank 0's resume journal: the reports since the last one, every journal_seconds.
     std::uint64_t unjournaled = 0;
@@ -272,6 +279,12 @@ int run(int argc, char** argv)
     const ScheduleResult r = run_schedule(world, costs.pending(), work, done, [] { return false; }, o.schedule);
     if (rank == 0) fs.write(16.0 * static_cast<double>(unjournaled) + 4096);
     const double scheduled = MPI_Wtime();
+    if (o.trace) {
+        std::fprintf(stderr, "trace rank=%d last_end=%.3f busy=%.3f tiles=%llu blocks=%llu given_back=%llu idle=%.3f leader=%d\n",
+                     rank, work.last_end - start, work.busy, static_cast<unsigned long long>(r.stats.tiles),
+                     static_cast<unsigned long long>(r.stats.blocks), static_cast<unsigned long long>(r.stats.given_back),
+                     r.stats.idle_seconds, r.stats.leader ? 1 : 0);
+    }
 
     // The closing pass: every rank reads back its share of the raw data, compresses it and
     // writes the compressed result.
@@ -328,8 +341,16 @@ int run(int argc, char** argv)
 
 int main(int argc, char** argv)
 {
+    // Not mpi::Environment: it asks for MPI_THREAD_FUNNELED (the real writer's threads),
+    // which SMPI does not provide, and nothing here starts a thread.
+    struct Session {
+        Session() { superball::mpi::check(MPI_Init(nullptr, nullptr), "MPI_Init"); }
+        ~Session() { MPI_Finalize(); }
+        Session(const Session&) = delete;
+        Session& operator=(const Session&) = delete;
+    };
     try {
-        const mpi::Environment env;
+        const Session session;
         return run(argc, argv);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "sim_run: %s\n", e.what());
