@@ -90,7 +90,8 @@ double now() { return MPI_Wtime(); }
 // When a server's pool is empty for good (rank 0's, or a leader's once rank 0 has
 // nothing more), the ranks that ask are not sent away while others still hold unstarted
 // tiles: the server asks the rank holding the most (it learns that from every message)
-// to give back the second half of them, and hands those out. Costs cluster in the tile
+// to give back the second half of them (a leader so asked asks in turn every rank of its
+// node holding two or more), and hands those out. Costs cluster in the tile
 // order (a block of the first, largest blocks can hold many times a rank's share of the
 // work), so without this the run would last as long as its costliest block.
 class Scheduler {

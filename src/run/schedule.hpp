@@ -71,7 +71,7 @@ struct ScheduleSettings {
     // never). Below it, a computing rank 0 loses little: it answers within a few hundred
     // points and its share of the work is 1/P; from about 64 ranks on its answers are
     // late often enough, and its share small enough, that one rank is better spent
-    // scheduling (tests/scale/README_section.md has the simulated comparison).
+    // scheduling.
     int dedicated_root_ranks = 64;
     // 0: nodes are the ranks sharing memory (MPI_Comm_split_type). n > 0: pseudo-nodes of
     // n consecutive ranks, which forces the two-level scheme on one machine (tests), or

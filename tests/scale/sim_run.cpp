@@ -325,13 +325,14 @@ int run(int argc, char** argv)
         const double ideal = total / ranks;
         std::printf("ranks=%d efficiency=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "
                     "finish_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu root_messages=%llu "
-                    "max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f root_asked_back=%llu idle_s_per_rank=%.6g\n",
+                    "max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f root_asked_back=%llu idle_s_per_rank=%.6g "
+                    "reported=%llu\n",
                     ranks, ideal / predicted, predicted, ideal, total, schedule_s, end - scheduled,
                     last_busy - first_idle, static_cast<unsigned long long>(costs.tiles()),
                     static_cast<unsigned long long>(r.stats.requests_in),
                     static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(),
                     ops, r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back),
-                    idle / ranks);
+                    idle / ranks, static_cast<unsigned long long>(reported));
         std::fflush(stdout);
     }
     return 0;
