@@ -28,6 +28,7 @@ bool sets_key(std::string_view params, std::string_view key)
     return false;
 }
 
+#ifdef OPEN_MPI  // only Open MPI reads it (SMPI, tests/scale, is another MPI)
 std::string user_mca_params(const Getenv& getenv)
 {
     const char* home = getenv("HOME");
@@ -35,6 +36,7 @@ std::string user_mca_params(const Getenv& getenv)
     std::ifstream in(std::string(home) + "/.openmpi/mca-params.conf");
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
+#endif
 
 }  // namespace
 
@@ -216,6 +218,42 @@ void Comm::abort(int status) const
 {
     MPI_Abort(comm_, status);
     std::abort();
+}
+
+OwnedComm::~OwnedComm()
+{
+    if (comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
+}
+
+OwnedComm& OwnedComm::operator=(OwnedComm&& o) noexcept
+{
+    if (this != &o) {
+        if (comm_ != MPI_COMM_NULL) MPI_Comm_free(&comm_);
+        comm_ = o.comm_;
+        o.comm_ = MPI_COMM_NULL;
+    }
+    return *this;
+}
+
+OwnedComm OwnedComm::split(const Comm& c, int color, int key)
+{
+    MPI_Comm out = MPI_COMM_NULL;
+    check(MPI_Comm_split(c.get(), color, key, &out), "MPI_Comm_split");
+    return OwnedComm(out);
+}
+
+OwnedComm OwnedComm::split_shared(const Comm& c, int key)
+{
+    MPI_Comm out = MPI_COMM_NULL;
+    check(MPI_Comm_split_type(c.get(), MPI_COMM_TYPE_SHARED, key, MPI_INFO_NULL, &out), "MPI_Comm_split_type");
+    return OwnedComm(out);
+}
+
+OwnedComm OwnedComm::dup(const Comm& c)
+{
+    MPI_Comm out = MPI_COMM_NULL;
+    check(MPI_Comm_dup(c.get(), &out), "MPI_Comm_dup");
+    return OwnedComm(out);
 }
 
 }  // namespace superball::mpi

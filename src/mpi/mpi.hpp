@@ -113,4 +113,32 @@ private:
     MPI_Comm comm_;
 };
 
+// A communicator made from another (split, dup) and freed with this object. Collective
+// like the calls that make it; destroy it before MPI_Finalize.
+class OwnedComm {
+public:
+    OwnedComm() = default;
+    ~OwnedComm();
+    OwnedComm(OwnedComm&& o) noexcept : comm_(o.comm_) { o.comm_ = MPI_COMM_NULL; }
+    OwnedComm& operator=(OwnedComm&& o) noexcept;
+    OwnedComm(const OwnedComm&) = delete;
+    OwnedComm& operator=(const OwnedComm&) = delete;
+
+    // MPI_Comm_split: ranks of equal `color` together, ordered by `key`; MPI_UNDEFINED
+    // gives a null communicator.
+    static OwnedComm split(const Comm& c, int color, int key);
+    // MPI_Comm_split_type(MPI_COMM_TYPE_SHARED): the ranks that share this rank's memory
+    // (its node), ordered by `key`.
+    static OwnedComm split_shared(const Comm& c, int key);
+    static OwnedComm dup(const Comm& c);
+
+    bool null() const { return comm_ == MPI_COMM_NULL; }
+    MPI_Comm get() const { return comm_; }
+    Comm view() const { return Comm(comm_); }
+
+private:
+    explicit OwnedComm(MPI_Comm c) : comm_(c) {}
+    MPI_Comm comm_ = MPI_COMM_NULL;
+};
+
 }  // namespace superball::mpi

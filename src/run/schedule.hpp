@@ -3,10 +3,21 @@
 // The cost of a point varies by orders of magnitude across a grid (one bounce near the
 // edges, up to max_bounces near self-similar motions), so tiles are handed out on
 // demand rather than split statically, in blocks of consecutive tiles whose size shrinks
-// as the work runs out (guided self-scheduling): the scheduler answers O(P log(N/P))
-// requests for N tiles on P ranks, not N, and the last blocks are single tiles so the
-// ranks finish together. Results never depend on the schedule: every tile is computed
-// the same way wherever it runs.
+// as the work runs out (guided self-scheduling, a block being remaining / (2 ranks)):
+// the scheduler answers O(P log(N/P)) requests for N tiles on P ranks, not N, and the
+// last blocks are single tiles so the ranks finish together. Results never depend on the
+// schedule: every tile is computed the same way wherever it runs.
+//
+// Who serves whom:
+// - every rank that computes keeps its next block queued: it asks for one when it starts
+//   the block before, so it never waits on a round trip;
+// - rank 0 hands out blocks. Below `dedicated_root_ranks` ranks it computes too and
+//   answers between blocks of points (the Serve callback); from there on it only
+//   schedules;
+// - across nodes (more than one node, found with MPI_Comm_split_type), rank 0 hands big
+//   blocks to one leader per node, which sub-divides them among its node's ranks and
+//   forwards their reports, so no process serves more than its node's requests plus one
+//   message per leader (see README, "Running on a cluster").
 #pragma once
 
 #include <cstdint>
@@ -37,24 +48,64 @@ public:
     virtual std::vector<TileReport> flush() = 0;
 };
 
-// Called on rank 0 for finished tiles (written, see TileWork::flush), whichever rank
+// Called on rank 0 for finished tiles (written, see TileWork::flush), with the rank that
 // computed them.
 using TilesDone = std::function<void(std::span<const TileReport> tiles, int rank)>;
-// Polled on every rank between tiles: true on any rank stops the handing out of work
-// (the run is interrupted; the tile being computed is finished, written and reported).
+// Polled on every rank between tiles: true on any rank stops the run. Every rank then
+// finishes the tile it is computing, drops the rest of its blocks, writes and reports
+// what it computed, and returns (the run is interrupted).
 using StopRequested = std::function<bool()>;
 
 struct ScheduleSettings {
-    // A rank with finished tiles reports them (flushing its writes) at least this often,
-    // so the resume journal lags the work by no more than that.
+    // A rank with finished tiles flushes them and reports them at least this often, so
+    // that the resume journal lags the work by little (node leaders pass reports on
+    // every report_seconds / 2).
     double report_seconds = 1.0;
     // Blocks are multiples of this many tiles where they can be (a stripe of the file
     // system's alignment, so that two ranks' writes do not share one).
     std::uint64_t granule = 1;
+    // A block is what is left over (block_divisor x ranks), per rank it serves (guided
+    // self-scheduling; at least one tile).
+    std::uint64_t block_divisor = 2;
+    // With at least this many ranks, rank 0 computes no tile and only schedules (0:
+    // never). Below it, a computing rank 0 loses little: it answers within a few hundred
+    // points and its share of the work is 1/P; from about 64 ranks on its answers are
+    // late often enough, and its share small enough, that one rank is better spent
+    // scheduling.
+    int dedicated_root_ranks = 64;
+    // 0: nodes are the ranks sharing memory (MPI_Comm_split_type). n > 0: pseudo-nodes of
+    // n consecutive ranks, which forces the two-level scheme on one machine (tests), or
+    // names the nodes where MPI_Comm_split_type cannot (SMPI).
+    int node_ranks = 0;
+    // A server with nothing to do (a dedicated rank 0, a leader whose ranks are busy)
+    // sleeps between looks for messages, longer and longer up to this: the delay of its
+    // first answer after a quiet spell, and of its noticing a stop signal. (Idle, it
+    // costs nothing either way; a simulation of hours of cluster time wants fewer looks.)
+    double idle_poll_seconds = 1e-3;
+};
+
+// What one rank saw of the schedule (for tests, benchmarks and the simulation).
+struct ScheduleStats {
+    std::uint64_t tiles = 0;         // tiles this rank computed
+    std::uint64_t blocks = 0;        // blocks it computed
+    std::uint64_t flushes = 0;       // TileWork::flush calls that returned tiles
+    std::uint64_t messages_in = 0;   // messages it received from the ranks it serves
+    std::uint64_t requests_in = 0;   // of which requests for a block
+    std::uint64_t messages_out = 0;  // messages it sent to the rank that serves it
+    // Sizes of the blocks a server (rank 0, node leaders) took from its pool, for the
+    // ranks it serves and for itself, in order.
+    std::vector<std::uint64_t> handed_out;
+    std::uint64_t given_back = 0;    // tiles it gave back (to its server, or to its own pool)
+    std::uint64_t asked_back = 0;    // requests for tiles back it sent to the ranks it serves
+    double idle_seconds = 0;         // time it waited with nothing to compute (or to serve)
+    bool two_level = false;          // node leaders were used (same on every rank)
+    bool leader = false;             // this rank served a node (rank 0 included)
+    bool computed = false;           // this rank computed tiles (false: a scheduler only)
 };
 
 struct ScheduleResult {
     bool interrupted = false;  // on every rank: tiles were left undone on purpose
+    ScheduleStats stats;       // this rank's
 };
 
 // Collective over `comm`. `pending` (identical on every rank): the tiles to compute, in

@@ -1,0 +1,279 @@
+// run_explore (run/explore.hpp) under MPI, at whatever rank count the test runs with
+// (ctest: 1 to 4): the result equals the kernel applied point by point, with no MPI, so
+// every rank count gives the same file; a run stopped part-way keeps only its partial
+// file and --resume completes it to the same result; refinement does not depend on the
+// rank count; rank 0's observer sees every tile once; plans refuse alike on every rank.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/count.hpp"
+#include "core/kernels.hpp"
+#include "io/layout.hpp"
+#include "io/result_reader.hpp"
+#include "job/grid.hpp"
+#include "job/job.hpp"
+#include "mpi/mpi.hpp"
+#include "run/explore.hpp"
+#include "run/refine.hpp"
+#include "run/tile_counter.hpp"
+
+namespace superball {
+namespace {
+
+namespace fs = std::filesystem;
+
+const mpi::Comm world = mpi::Comm::world();
+
+// A directory of rank 0's making, the same path on every rank, removed at the end.
+class SharedDir {
+public:
+    SharedDir()
+    {
+        std::string p;
+        if (world.is_root()) {
+            std::string templ = (fs::temp_directory_path() / "superball-runs-XXXXXX").string();
+            p = mkdtemp(templ.data()) ? templ : "";
+        }
+        world.broadcast(p);
+        if (p.empty()) throw std::runtime_error("mkdtemp failed");
+        path_ = p;
+    }
+    ~SharedDir()
+    {
+        world.barrier();
+        std::error_code ec;
+        if (world.is_root()) fs::remove_all(path_, ec);
+    }
+    SharedDir(const SharedDir&) = delete;
+    SharedDir& operator=(const SharedDir&) = delete;
+    fs::path operator/(const std::string& name) const { return path_ / name; }
+
+private:
+    fs::path path_;
+};
+
+Job job_of(const std::string& run = "tile_points = 64", int max_bounces = 1000)
+{
+    return parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 61 }\nU = -1.0\n"
+                     "W = { min = -3.0, max = 3.0, n = 47 }\n[run]\nmax_bounces = " +
+                         std::to_string(max_bounces) + "\n" + run + "\n",
+                     "test job");
+}
+
+struct Data {
+    std::vector<std::uint32_t> counts;
+    std::vector<std::uint8_t> outcomes;
+};
+
+// The whole grid counted point by point by the scalar kernel: no MPI, no tiles, no files.
+Data direct(const Job& job)
+{
+    const Grid grid(job);
+    const Extent shape = grid.shape();
+    const Box all{Extent(shape.size(), 0), shape};
+    Starts starts;
+    grid.starts(all, starts);
+    Data d{std::vector<std::uint32_t>(starts.size()), std::vector<std::uint8_t>(starts.size())};
+    count_each(starts.view(), ModelMatrices::of(job.model), job.max_bounces, d.counts, d.outcomes);
+    return d;
+}
+
+Data read_result(const fs::path& path)
+{
+    const ResultReader reader(path);
+    const ResultInfo& info = reader.info();
+    EXPECT_EQ(info.kind, FileKind::result);
+    const Box all{Extent(info.shape.size(), 0), info.shape};
+    Data d{std::vector<std::uint32_t>(all.points()), std::vector<std::uint8_t>(all.points())};
+    EXPECT_EQ(reader.read(all, d.counts, d.outcomes), 0u);
+    return d;
+}
+
+// Counts rank 0's observer calls.
+class Tally final : public RunObserver {
+public:
+    void started(const RunStart& s) override
+    {
+        ++starts;
+        start = s;
+    }
+    void tiles_done(std::uint64_t t, std::uint64_t p) override
+    {
+        tiles += t;
+        points += p;
+    }
+    void computed(double) override { ++computes; }
+    void finishing() override { ++finishes; }
+
+    RunStart start;
+    int starts = 0, computes = 0, finishes = 0;
+    std::uint64_t tiles = 0, points = 0;
+};
+
+const StopRequested never = [] { return false; };
+
+// Settings for an output: the best kernel of this processor unless told otherwise (the
+// scalar one gives the same bits, tests/core/test_kernels.cpp).
+ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrite = false,
+                         CountKernel kernel = best_kernel().count)
+{
+    ExploreSettings s;
+    s.output = out;
+    s.resume = resume;
+    s.overwrite = overwrite;
+    s.kernel = kernel;
+    return s;
+}
+
+TEST(RunExplore, EqualsTheKernelPointByPointAtAnyRankCount)
+{
+    const SharedDir dir;
+    const Job job = job_of();
+    Tally tally;
+    const RunSummary r = run_explore(job, settings(dir / "r.h5"), world, tally, never);
+    EXPECT_TRUE(r.complete);
+    EXPECT_FALSE(r.interrupted);
+    EXPECT_EQ(r.points_this_run, job.points());
+    EXPECT_EQ(r.ranks, world.size());
+    std::uint64_t histogram = 0;
+    for (const std::uint64_t n : r.outcomes) histogram += n;
+    EXPECT_EQ(histogram, job.points());
+    if (world.is_root()) {
+        EXPECT_EQ(tally.starts, 1);
+        EXPECT_EQ(tally.computes, 1);
+        EXPECT_EQ(tally.finishes, 1);
+        EXPECT_EQ(tally.tiles, tally.start.tiles);  // every tile once
+        EXPECT_EQ(tally.points, job.points());
+        const Data got = read_result(dir / "r.h5");
+        const Data want = direct(job);
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+        EXPECT_FALSE(fs::exists(layout::partial_path(dir / "r.h5")));
+        EXPECT_TRUE(fs::exists(dir / "r.xmf"));
+    }
+}
+
+TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
+{
+    const SharedDir dir;
+    // Tiles of 16 points: about 180 of them; the journal at every report.
+    const Job job = job_of("tile_points = 16\ncheckpoint_seconds = 0.01");
+    const fs::path out = dir / "stopped.h5";
+    // Rank 0 asks for a stop the tenth of the tiles' count time it is asked (it is asked
+    // between its tiles, and its first block is larger than that at up to 4 ranks: it has
+    // computed tiles by then). Not from the tiles reported: a lone rank reports every
+    // second, long after this job is done.
+    Tally tally;
+    std::uint64_t polls = 0;
+    const StopRequested stop = [&] {
+        return world.is_root() && tally.start.tiles > 0 && ++polls > tally.start.tiles / 10;
+    };
+    const RunSummary first = run_explore(job, settings(out), world, tally, stop);
+    EXPECT_TRUE(first.interrupted);
+    EXPECT_FALSE(first.complete);
+    if (world.is_root()) {
+        EXPECT_FALSE(fs::exists(out));
+        ASSERT_TRUE(fs::exists(layout::partial_path(out)));
+        const ResultReader partial(layout::partial_path(out));
+        EXPECT_EQ(partial.info().kind, FileKind::partial);
+        EXPECT_GT(partial.info().tiles_done, 0u);
+        EXPECT_LT(partial.info().tiles_done, partial.info().tiles);
+        EXPECT_TRUE(partial.damaged_tiles().empty());
+    }
+    // Without --resume the interrupted run is refused, on every rank alike.
+    Tally refused;
+    EXPECT_THROW(run_explore(job, settings(out), world, refused, never), InputError);
+    Tally again;
+    const RunSummary second = run_explore(job, settings(out, true, false, scalar_kernel().count), world, again, never);
+    EXPECT_TRUE(second.complete);
+    EXPECT_LT(second.points_this_run, job.points());  // only the tiles not done
+    if (world.is_root()) {
+        EXPECT_GT(again.start.tiles_done, 0u);
+        EXPECT_EQ(again.start.tiles_done + again.tiles, again.start.tiles);
+        const Data got = read_result(out);
+        const Data want = direct(job);
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+        EXPECT_FALSE(fs::exists(layout::partial_path(out)));
+    }
+    // Complete: --resume has nothing to do.
+    Tally nothing;
+    const RunSummary third = run_explore(job, settings(out, true, false), world, nothing, never);
+    EXPECT_TRUE(third.nothing_to_do);
+}
+
+TEST(RunExplore, RefinementDoesNotDependOnTheRankCount)
+{
+    const SharedDir dir;
+    const Job job = job_of("refine = 8");
+    Tally tally;
+    const RunSummary r = run_explore(job, settings(dir / "refined.h5"), world, tally, never);
+    EXPECT_TRUE(r.complete);
+    EXPECT_LT(r.points_counted, job.points());  // refinement computed fewer points
+    if (world.is_root()) {
+        // The same tiles refined one after the other, with no MPI and no files.
+        const Grid grid(job);
+        const Tiling tiling = default_tiling(job, 1);
+        TileCounter counter(&count_each, job.max_bounces);
+        Data want{std::vector<std::uint32_t>(job.points()), std::vector<std::uint8_t>(job.points())};
+        Starts starts;
+        std::vector<ModelRun> runs;
+        const Extent shape = grid.shape();
+        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
+            const Box box = tiling.box(t);
+            grid.starts(box, starts);
+            grid.model_runs(box, runs);
+            std::vector<std::uint32_t> c(starts.size());
+            std::vector<std::uint8_t> o(starts.size());
+            const CountPoints some = [&](std::span<const std::uint64_t> points) {
+                counter.some(points, starts, runs, c, o, Serve());
+            };
+            refine_tile(box.count, job.refine, some, c, o);
+            for (std::uint64_t i = 0; i < box.count[0]; ++i) {
+                for (std::uint64_t j = 0; j < box.count[1]; ++j) {
+                    const std::uint64_t at = (box.start[0] + i) * shape[1] + box.start[1] + j;
+                    want.counts[at] = c[i * box.count[1] + j];
+                    want.outcomes[at] = o[i * box.count[1] + j];
+                }
+            }
+        }
+        const Data got = read_result(dir / "refined.h5");
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+    }
+}
+
+TEST(RunExplore, PlansRefuseAlikeOnEveryRank)
+{
+    const SharedDir dir;
+    const Job job = job_of();
+    const fs::path out = dir / "done.h5";
+    Tally tally;
+    run_explore(job, settings(out), world, tally, never);
+    // An existing result without --overwrite or --resume; another job's result with --resume.
+    EXPECT_THROW(plan_explore(job, settings(out), world), InputError);
+    const Job other = job_of("tile_points = 64", 999);
+    EXPECT_THROW(plan_explore(other, settings(out, true, false), world), InputError);
+    EXPECT_EQ(plan_explore(job, settings(out, false, true), world).mode, PlanMode::fresh);
+    EXPECT_EQ(plan_explore(job, settings(out, true, false), world).mode, PlanMode::complete);
+    // Not superball's: refused even with --overwrite, and left as it was.
+    const fs::path text = dir / "thesis.tex";
+    if (world.is_root()) {
+        std::FILE* f = std::fopen(text.c_str(), "w");
+        ASSERT_NE(f, nullptr);
+        std::fputs("\\documentclass{article}\n", f);
+        std::fclose(f);
+    }
+    world.barrier();
+    EXPECT_THROW(plan_explore(job, settings(text, false, true), world), InputError);
+    if (world.is_root()) {
+        EXPECT_EQ(fs::file_size(text), 24u);
+    }
+}
+
+}  // namespace
+}  // namespace superball

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Checks the model of tests/scale/simulate.sh against real runs on this machine: the same
+# simulation (the real schedule under SMPI; tile costs from the job at 1/8 of its points,
+# computed at -n 1, whose compute time gives the job's cost per wall bounce, and
+# tests/scale/calibration.env) on tests/scale/local.xml (one host of 2 cores, which
+# oversubscribed ranks share), against the compute phase `superball explore` reports
+# ("computed in"), median of REPS runs. Prints one line per case:
+#
+#   job=NAME ranks=N real_s=R predicted_s=P error=E
+#
+# with error = (P - R) / R. The cases: the 512^3 volume of jobs/full (light points), a
+# small copy of the corner zoom of jobs/cluster (heavy-tailed costs), and the trivial grid
+# with 1024-point tiles oversubscribed (65536 tiles: the schedule's own cost and the
+# sharing of the cores).
+#
+#   tests/scale/validate.sh [REPS]
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+cd "$root"
+reps=${1:-3}
+.ci/install-deps --scale
+cmake --preset release >/dev/null
+cmake --build build/release -j"$(nproc)" --target superball scale_costs >/dev/null
+if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
+superball=$root/build/release/src/superball
+scale_costs=$root/build/release/tests/scale/scale_costs
+out=$root/build/scale/validate
+mkdir -p "$out"
+tests/scale/build_sim_run.sh "$root/build/scale/sim_run"
+# shellcheck source=calibration.env
+source tests/scale/calibration.env
+
+# The cases: a job file and the rank counts it runs at.
+cat >"$out/zoom.toml" <<EOF
+[model]
+e = 0.9999
+alpha = 0.9999
+[grid]
+coordinates = "canonical"
+xi = { min = 0.0, max = 0.01, n = 96 }
+U = { min = -3.0, max = 0.0, n = 64 }
+W = { min = -6.0, max = 3.0, n = 64 }
+[run]
+max_bounces = 20000
+output = "$out/zoom.h5"
+EOF
+cat >"$out/trivial.toml" <<EOF
+[model]
+e = 0.9
+alpha = 0.9
+[grid]
+coordinates = "canonical"
+xi = { min = 1.0, max = 2.0, n = 8192 }
+U = -1.0
+W = { min = -3.0, max = 3.0, n = 8192 }
+[run]
+max_bounces = 1000
+output = "$out/trivial.h5"
+tile_points = 1024
+EOF
+cases=("jobs/full/volume.toml:1 2" "$out/zoom.toml:1 2 4" "$out/trivial.toml:4 8")
+
+computed() {  # compute-phase seconds of a real run: JOB RANKS
+  mpirun -n "$2" --oversubscribe "$superball" explore "$1" -o "$out/real.h5" --overwrite -q 2>&1 |
+    sed -n 's/.*computed in \([0-9.]*\) s.*/\1/p'
+}
+predicted() {  # schedule_s of the simulation: NAME JOB RANKS NS_PER_ITERATION
+  local granule
+  granule=$("$scale_costs" "$2" "$3" "$out/$1.low.h5" "$NS_PER_POINT" "$4" "$US_PER_TILE" "$out/$1.$3.bin" |
+    sed -n 's/.* granule=\([0-9]*\) .*/\1/p')
+  echo "node-0:$3" >"$out/hosts"
+  smpirun -np "$3" -platform tests/scale/local.xml -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$1.$3.bin" \
+    --node-ranks "$3" --granule "$granule" --no-io --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no \
+    --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536 2>"$out/$1.$3.log" |
+    sed -n 's/.* schedule_s=\([^ ]*\).*/\1/p'
+  rm -f "$out/$1.$3.bin"
+}
+
+for c in "${cases[@]}"; do
+  job=${c%%:*}
+  name=$(basename "$job" .toml)
+  # The cost model's sample: the job at half the resolution along each axis.
+  /usr/bin/python3 tests/scale/lowres_job.py "$job" "$out/$name.low.toml" "$out/$name.low.h5" \
+    --points "$(( $("$superball" explore "$job" --dry-run | sed -n 's/^points: //p') / 8 ))"
+  # Computed at -n 1: its compute time gives the job's cost per wall bounce, as in simulate.sh.
+  seconds=$(computed "$out/$name.low.toml" 1)
+  mv "$out/real.h5" "$out/$name.low.h5"
+  tiles=$("$superball" explore "$out/$name.low.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
+  read -r ns_per_iteration _ < <(/usr/bin/python3 tests/scale/sample_model.py "$out/$name.low.h5" "$seconds" "$tiles" \
+    "$NS_PER_POINT" "$US_PER_TILE" "$NS_PER_ITERATION")
+  for n in ${c#*:}; do
+    times=()
+    for ((r = 0; r < reps; r++)); do times+=("$(computed "$job" "$n")"); done
+    real=$(printf '%s\n' "${times[@]}" | sort -g | sed -n "$(( (reps + 1) / 2 ))p")
+    model=$(predicted "$name" "$job" "$n" "$ns_per_iteration")
+    /usr/bin/python3 -c "print(f'job=$name ranks=$n real_s=$real predicted_s={$model:.3f} error={($model - $real) / $real:+.1%}  (real runs: ${times[*]}; ns_per_iteration=$ns_per_iteration)')"
+  done
+done
