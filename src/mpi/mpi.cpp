@@ -85,8 +85,8 @@ Environment::Environment()
             std::string dir = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/superball-mpi-XXXXXX";
             // Without it the process still runs, sharing the directory as before.
             if (::mkdtemp(dir.data()) != nullptr) {
-                session_base_ = dir;
                 ::setenv("OMPI_MCA_orte_tmpdir_base", dir.c_str(), 1);
+                session_base_.emplace(std::move(dir));
             }
         }
     }
@@ -94,11 +94,7 @@ Environment::Environment()
     // The command-line arguments are not MPI's business. FUNNELED: the run's writer threads
     // (io/posix_file.hpp) make no MPI call, only the main thread does.
     int provided = MPI_THREAD_SINGLE;
-    if (const int code = MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided); code != MPI_SUCCESS) {
-        std::error_code ignored;
-        if (!session_base_.empty()) std::filesystem::remove_all(session_base_, ignored);
-        check(code, "MPI_Init_thread");
-    }
+    check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
     if (provided < MPI_THREAD_FUNNELED) {
         MPI_Finalize();
         throw std::runtime_error("MPI_Init_thread: this MPI library cannot run a process with threads (MPI_THREAD_FUNNELED)");
@@ -106,13 +102,12 @@ Environment::Environment()
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
 }
 
-Environment::~Environment()
+Environment::~Environment() { MPI_Finalize(); }
+
+Environment::PrivateDirectory::~PrivateDirectory()
 {
-    MPI_Finalize();
-    if (!session_base_.empty()) {
-        std::error_code ignored;  // a directory left in /tmp is no reason to fail a finished run
-        std::filesystem::remove_all(session_base_, ignored);
-    }
+    std::error_code ignored;  // a directory left in /tmp is no reason to fail a finished run
+    std::filesystem::remove_all(path_, ignored);
 }
 
 Info::Info() { check(MPI_Info_create(&info_), "MPI_Info_create"); }

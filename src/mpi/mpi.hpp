@@ -6,9 +6,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace superball::mpi {
@@ -63,7 +65,19 @@ public:
     Environment& operator=(const Environment&) = delete;
 
 private:
-    std::string session_base_;  // the private session directory, or empty
+    // A directory removed, with what is in it, when the object goes: after MPI_Finalize
+    // (members outlive the destructor's body), and on every way out of a failed start.
+    class PrivateDirectory {
+    public:
+        explicit PrivateDirectory(std::string path) : path_(std::move(path)) {}
+        ~PrivateDirectory();
+        PrivateDirectory(const PrivateDirectory&) = delete;
+        PrivateDirectory& operator=(const PrivateDirectory&) = delete;
+
+    private:
+        std::string path_;
+    };
+    std::optional<PrivateDirectory> session_base_;
 };
 
 // An MPI_Info object of hints (MPI-IO's, here), freed with the object.
