@@ -1,5 +1,6 @@
 #include "mpi.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -53,13 +54,21 @@ std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view u
             if (is_set(getenv, launcher)) return {};
         }
     }
-    std::vector<McaSetting> wanted{{"pml", "ob1"}};
-    if (singleton) wanted.push_back({"ess_singleton_isolated", "1"});
+    // Each setting with the parameters whose value, set by the user, means it is left
+    // alone: choosing an I/O component (io = romio321) makes the choice of OMPIO's
+    // collective writer moot.
+    struct Wanted {
+        McaSetting setting;
+        std::vector<std::string> unless;
+    };
+    std::vector<Wanted> wanted{{{"pml", "ob1"}, {"pml"}}, {{"fcoll", "two_phase"}, {"fcoll", "io"}}};
+    if (singleton) wanted.push_back({{"ess_singleton_isolated", "1"}, {"ess_singleton_isolated"}});
     std::vector<McaSetting> settings;
-    for (McaSetting& s : wanted) {
-        if (!is_set(getenv, ("OMPI_MCA_" + s.name).c_str()) && !sets_key(user_params, s.name)) {
-            settings.push_back(std::move(s));
-        }
+    for (Wanted& w : wanted) {
+        const bool users = std::any_of(w.unless.begin(), w.unless.end(), [&](const std::string& name) {
+            return is_set(getenv, ("OMPI_MCA_" + name).c_str()) || sets_key(user_params, name);
+        });
+        if (!users) settings.push_back(std::move(w.setting));
     }
     return settings;
 }

@@ -35,7 +35,15 @@ void check(int code, const char* what);
 //                                 ranks are all on this node (OMPI_COMM_WORLD_LOCAL_SIZE =
 //                                 OMPI_COMM_WORLD_SIZE);
 //   ess_singleton_isolated = 1    (no daemon: superball never spawns or connects to other
-//                                 processes) for a singleton.
+//                                 processes) for a singleton;
+//   fcoll = two_phase             (OMPIO's two-phase collective writer, ROMIO's algorithm,
+//                                 for both: the closing pass of a run writes its small
+//                                 compressed chunks in collective writes, which OMPIO's
+//                                 default writer, vulcan, issues as 3.4 times as many
+//                                 write calls: 134 against 39 for the 8192^2 slice at -n 2;
+//                                 README, Running on a cluster). Left alone when the user
+//                                 chose fcoll or the I/O component (io = romio321, which
+//                                 Open MPI itself takes on Lustre).
 // A parameter the user set is left alone: OMPI_MCA_<name> in the environment, even set to
 // nothing (also how `mpirun --mca NAME VALUE` reaches the ranks), or a line in
 // `user_params`, the text of ~/.openmpi/mca-params.conf; and nothing is set when other
