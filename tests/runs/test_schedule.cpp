@@ -385,7 +385,7 @@ TEST(ScheduleOneLevel, BlocksShrinkAndAreFew)
 
 // The first eighth of the tiles costs 8 ms, the rest nothing, so the first block (half a
 // rank's share of tiles) holds all of the work: the ranks that run out of blocks take the
-// second half of what others hold, and the costly tiles end up shared. (Counted, not
+// unstarted tiles others hold (all but their next), and the costly tiles end up shared. (Counted, not
 // timed: this machine's load makes times vary.)
 TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
 {
