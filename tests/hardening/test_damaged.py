@@ -348,18 +348,24 @@ CASES = [
 ]
 
 
+def make_result(cls, prefix, env):
+    """The test class's binary, a fresh directory holding JOB and the result of it (every
+    test class of this file starts from one)."""
+    cls.binary = superball_binary()
+    cls.dir = tempfile.mkdtemp(prefix=prefix)
+    cls.job = os.path.join(cls.dir, "job.toml")
+    with open(cls.job, "w") as f:
+        f.write(JOB)
+    cls.result = os.path.join(cls.dir, "result.h5")
+    r = subprocess.run([cls.binary, "explore", cls.job, "-o", cls.result, "-q"], capture_output=True, text=True,
+                       env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+
+
 class Damaged(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.binary = superball_binary()
-        cls.dir = tempfile.mkdtemp(prefix="superball-damaged-")
-        cls.job = os.path.join(cls.dir, "job.toml")
-        with open(cls.job, "w") as f:
-            f.write(JOB)
-        cls.result = os.path.join(cls.dir, "result.h5")
-        r = subprocess.run([cls.binary, "explore", cls.job, "-o", cls.result, "-q"], capture_output=True, text=True,
-                           env=mpi_env(), timeout=120)
-        assert r.returncode == 0, r.stderr
+        make_result(cls, "superball-damaged-", mpi_env())
         cls.partial = interrupted_run(cls.binary, cls.job, os.path.join(cls.dir, "interrupted.h5"), cls.result,
                                       lambda t: t % 2 == 0)
 
@@ -485,13 +491,7 @@ class Overwrite(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.binary = superball_binary()
-        cls.dir = tempfile.mkdtemp(prefix="superball-overwrite-")
-        cls.job = os.path.join(cls.dir, "job.toml")
-        with open(cls.job, "w") as f:
-            f.write(JOB)
-        cls.result = os.path.join(cls.dir, "result.h5")
-        assert cls.explore(cls, cls.result).returncode == 0
+        make_result(cls, "superball-overwrite-", singleton_env())
 
     @classmethod
     def tearDownClass(cls):
