@@ -48,6 +48,16 @@ std::uint64_t guided_block(std::uint64_t remaining, std::uint64_t ranks, std::ui
     return std::min(n, remaining);
 }
 
+// At most n tiles from the front of `r`, so that a block of a granule or more starts and
+// ends on granule boundaries: a range given back from the middle of a granule (ranks give
+// back tiles one by one, not granules) goes out first up to the next boundary.
+std::uint64_t aligned_block(Range r, std::uint64_t n, std::uint64_t granule)
+{
+    if (granule <= 1 || n < granule) return n;
+    const std::uint64_t into = r.first % granule;
+    return into != 0 ? granule - into : n - n % granule;
+}
+
 // Sleeps without holding the core another rank may need (with oversubscription, or the
 // node's other ranks). Under SMPI nanosleep is simulated time.
 void pause(double seconds)
@@ -222,7 +232,10 @@ private:
     {
         const std::uint64_t left =
             root_ ? pool_tiles_ : parent_remaining_ + pool_tiles_ * computing_ranks_ / node_computing_ranks_;
-        return std::min(pool_.front().count, guided_block(left, computing_ranks_, weight, settings_.granule, settings_.block_divisor));
+        const Range& front = pool_.front();
+        const std::uint64_t n =
+            std::min(front.count, guided_block(left, computing_ranks_, weight, settings_.granule, settings_.block_divisor));
+        return aligned_block(front, n, settings_.granule);
     }
 
     Range take(std::uint64_t n)
