@@ -209,11 +209,8 @@ void TileWriter::add(std::uint64_t tile, std::span<const std::uint32_t> counts, 
     const Extent& shape = file_.tiling().tile_shape();
     const bool edge = box.points() != n;  // the chunk's points beyond the grid stay zero
     const auto fill = [&](auto& v) {
-        // Grown once and reused: a resize after clear() would zero what is overwritten anyway;
-        // reserved whole at first, so that growing never copies what is already there.
-        if (v.capacity() < capacity_tiles_ * n) v.reserve(capacity_tiles_ * n);
-        if (v.size() < (b->count + 1) * n) v.resize((b->count + 1) * n);
-        auto* chunk = v.data() + b->count * n;
+        // Allocated whole at the first tile and reused; a chunk is written whole below.
+        auto* chunk = v.reserve(capacity_tiles_ * n) + b->count * n;
         using T = std::remove_reference_t<decltype(*chunk)>;
         if (edge) std::fill(chunk, chunk + n, T{0});
         return chunk;

@@ -20,6 +20,7 @@
 #include "job/job.hpp"
 #include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
+#include "page_buffer.hpp"
 #include "posix_file.hpp"
 
 namespace superball {
@@ -101,9 +102,9 @@ public:
 
 private:
     struct Buffer {
-        std::vector<std::uint16_t> counts16;  // 16-bit files
-        std::vector<std::uint32_t> counts32;  // 32-bit files
-        std::vector<std::uint8_t> outcomes;
+        PageArray<std::uint16_t> counts16;  // 16-bit files
+        PageArray<std::uint32_t> counts32;  // 32-bit files
+        PageArray<std::uint8_t> outcomes;
         std::uint64_t first = 0, count = 0;   // tiles [first, first + count)
         std::vector<TileReport> reports;
         std::future<void> written;  // valid while the buffer is being written
