@@ -9,7 +9,7 @@
 //
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
-//       [--flush-bytes 8388608] [--journal-seconds 10]
+//       [--flush-bytes 6291456] [--journal-seconds 10]
 //       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--serve-every 0.05] [--trace]
 #include <fcntl.h>
 #include <mpi.h>
@@ -88,7 +88,7 @@ private:
 struct Options {
     std::string costs;
     ScheduleSettings schedule;
-    double flush_bytes = 8 << 20;  // the writer's buffer
+    double flush_bytes = 6 << 20;  // the writer's buffer: 4 MiB of 16-bit counts, 2 MiB of outcomes (run/explore.cpp)
     double journal_seconds = 10;
     double compress_mbps = 100;    // shuffle + deflate, per core
     double compress_ratio = 100;
@@ -167,7 +167,7 @@ private:
 // answers requests for tiles back as late as the real one), and every --serve-every
 // seconds of compute elsewhere (fewer events: answers come later than in the real run by
 // at most that, never sooner);
-// writing by the writer's model: tiles buffered until ~8 MiB or a flush, then per run of
+// writing by the writer's model: tiles buffered until ~6 MiB or a flush, then per run of
 // consecutive tiles one write to /wall_bounces and one to /outcome.
 class ModelWork final : public TileWork {
 public:

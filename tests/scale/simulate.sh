@@ -29,7 +29,7 @@
 #      explore uses ([run] alignment / bytes of a tile's counts);
 #   3. smpirun on tests/scale/cluster.xml (128 nodes x 32 cores as fast as this machine's,
 #      fat tree, a file system of 20 GB/s with 1 ms per operation): sim_run replays the
-#      tiles' costs and the writer's I/O (flushes of 8 MiB, a resume journal on rank 0
+#      tiles' costs and the writer's I/O (flushes of 6 MiB, a resume journal on rank 0
 #      every 10 s, a closing pass that reads the raw data back, compresses it at
 #      COMPRESS_MBPS per core and writes it smaller by the ratio of the job's
 #      low-resolution result).
