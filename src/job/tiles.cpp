@@ -65,4 +65,38 @@ std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks)
     return std::clamp<std::uint64_t>(per_rank_share, 1024, 16384);
 }
 
+std::vector<std::uint64_t> handout_order(const std::vector<std::uint64_t>& pending, std::uint64_t granule, bool interleave)
+{
+    if (!interleave || granule == 0 || pending.empty()) return pending;
+    // Runs of pending tiles by granule number (t / granule), in pending's ascending order.
+    struct Run {
+        std::uint64_t granule, begin, end;  // [begin, end) positions in pending
+    };
+    std::vector<Run> runs;
+    for (std::uint64_t i = 0; i < pending.size(); ++i) {
+        const std::uint64_t g = pending[i] / granule;
+        if (runs.empty() || runs.back().granule != g) runs.push_back({g, i, i});
+        runs.back().end = i + 1;
+    }
+    int bits = 0;
+    while ((std::uint64_t{1} << bits) <= runs.back().granule) ++bits;
+    const auto reversed = [bits](std::uint64_t g) {
+        std::uint64_t r = 0;
+        for (int b = 0; b < bits; ++b) r |= ((g >> b) & 1u) << (bits - 1 - b);
+        return r;
+    };
+    // Whole granules in bit-reversed order, then the incomplete ones (a resume's, the
+    // grid's last) in grid order, so that the whole ones stay on multiples of `granule`.
+    const auto whole = [granule](const Run& r) { return r.end - r.begin == granule; };
+    std::stable_sort(runs.begin(), runs.end(), [&](const Run& a, const Run& b) {
+        if (whole(a) != whole(b)) return whole(a);
+        return whole(a) ? reversed(a.granule) < reversed(b.granule) : a.granule < b.granule;
+    });
+    std::vector<std::uint64_t> order;
+    order.reserve(pending.size());
+    for (const Run& r : runs) order.insert(order.end(), pending.begin() + static_cast<std::ptrdiff_t>(r.begin),
+                                           pending.begin() + static_cast<std::ptrdiff_t>(r.end));
+    return order;
+}
+
 }  // namespace superball

@@ -444,6 +444,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     };
     ScheduleSettings schedule;
     schedule.granule = std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    pending = handout_order(pending, schedule.granule, comm.size() >= settings.interleave_ranks);
     const auto compute_start = std::chrono::steady_clock::now();
     const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule);
     const double compute_seconds = comm.broadcast(seconds_since(compute_start));

@@ -33,6 +33,9 @@ struct ExploreSettings {
     bool resume = false;           // finish an interrupted run of the same job
     bool overwrite = false;        // replace an existing result
     CountKernel kernel = best_kernel().count;  // core/kernels.hpp: select_kernel()
+    // From this many ranks on, tiles are handed out interleaved (job/tiles.hpp,
+    // handout_order); tests set 1 to interleave at any rank count.
+    int interleave_ranks = interleave_ranks_default;
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]

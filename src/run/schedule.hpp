@@ -30,10 +30,20 @@
 
 namespace superball {
 
-// The rank that schedules calls `serve` from inside its own work every few hundred
-// points, so that waiting ranks get their next block promptly; elsewhere (and when no
-// other rank waits: a run on one rank) it is empty.
-using Serve = std::function<void()>;
+// Called from inside a rank's work every `points` points counted: a rank that serves
+// others answers them (blocks, tiles back), a served rank its server's requests for tiles
+// back. Empty on a rank alone (nobody to answer).
+struct Serve {
+    std::function<void()> call;
+    // Points counted between two calls. A rank serving many ranks answers more often: at
+    // 4096 simulated ranks, node leaders answering every 512 points (up to 0.1 s on the
+    // costliest tiles) left every rank waiting 3.2 s on average, every 64 points 0.7 s
+    // (tests/scale); smaller blocks cost the server a little of its own counting speed.
+    std::size_t points = 512;
+
+    explicit operator bool() const { return static_cast<bool>(call); }
+    void operator()() const { call(); }
+};
 
 // What a rank does with the tiles it is given.
 class TileWork {
@@ -67,6 +77,10 @@ struct ScheduleSettings {
     // A block is what is left over (block_divisor x ranks), per rank it serves (guided
     // self-scheduling; at least one tile).
     std::uint64_t block_divisor = 2;
+    // Points counted between two looks for messages on a rank that serves at least
+    // `busy_server_ranks` ranks (Serve::points; 512 elsewhere).
+    std::size_t server_points = 64;
+    int busy_server_ranks = 4;
     // With at least this many ranks, rank 0 computes no tile and only schedules (0:
     // never). Below it, a computing rank 0 loses little: it answers within a few hundred
     // points and its share of the work is 1/P; from about 64 ranks on its answers are

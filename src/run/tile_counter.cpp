@@ -14,8 +14,9 @@ void count_in_blocks(CountKernel kernel, const StartsView& starts, const ModelMa
         return;
     }
     // Small enough that the scheduling rank answers requests within milliseconds even where
-    // every point bounces to max_bounces, large enough to fill the vector kernel.
-    constexpr std::size_t block = 512;
+    // every point bounces to max_bounces, large enough to fill the vector kernel (512 on
+    // most ranks, fewer on a rank serving many: schedule.hpp).
+    const std::size_t block = std::max<std::size_t>(1, serve.points);
     for (std::size_t i = 0; i < starts.size(); i += block) {
         const std::size_t n = std::min(block, starts.size() - i);
         kernel(starts.subview(i, n), m, max_bounces, wall_bounces.subspan(i, n), outcomes.subspan(i, n));

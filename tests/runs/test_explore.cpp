@@ -206,6 +206,44 @@ TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
     EXPECT_TRUE(third.nothing_to_do);
 }
 
+// Tiles handed out interleaved (as from 64 ranks on, job/tiles.hpp handout_order), here at
+// any rank count: the same result, and a stopped run resumes to it (its incomplete
+// granules go last).
+TEST(RunExplore, InterleavedHandoutGivesTheSameResultAndResumes)
+{
+    const SharedDir dir;
+    // 4096 tiles of 16 points in granules of 128 (4096 bytes of counts, the alignment).
+    const Job job = parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 256 }\nU = -1.0\n"
+                              "W = { min = -3.0, max = 3.0, n = 256 }\n[run]\nmax_bounces = 1000\ntile_points = 16\n"
+                              "alignment = 4096\ncheckpoint_seconds = 0.01\n",
+                              "interleaved job");
+    ExploreSettings s = settings(dir / "whole.h5");
+    s.interleave_ranks = 1;
+    Tally tally;
+    EXPECT_TRUE(run_explore(job, s, world, tally, never).complete);
+    const Data want = direct(job);
+    if (world.is_root()) {
+        const Data got = read_result(dir / "whole.h5");
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+    }
+    s.output = dir / "stopped.h5";
+    Tally first;
+    std::uint64_t polls = 0;
+    const StopRequested stop = [&] { return world.is_root() && first.start.tiles > 0 && ++polls > first.start.tiles / 10; };
+    EXPECT_TRUE(run_explore(job, s, world, first, stop).interrupted);
+    s.resume = true;
+    Tally second;
+    EXPECT_TRUE(run_explore(job, s, world, second, never).complete);
+    if (world.is_root()) {
+        EXPECT_GT(second.start.tiles_done, 0u);
+        EXPECT_EQ(second.start.tiles_done + second.tiles, second.start.tiles);
+        const Data got = read_result(dir / "stopped.h5");
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+    }
+}
+
 TEST(RunExplore, RefinementDoesNotDependOnTheRankCount)
 {
     const SharedDir dir;

@@ -8,7 +8,8 @@
 // the sum over its points plus US_PER_TILE. The tiling is the one `superball explore`
 // makes for RANKS ranks (default_tiling). OUT.bin: "SBCOST01", then u64 tiles, bytes
 // written per point, points; tiles doubles (seconds); tiles u64 (points); tiles u64 (the
-// pending tiles of a fresh run, in order: 0, 1, ...; shared by all simulated ranks). Prints one
+// tiles of a fresh run in the order explore hands them out, job/tiles.hpp handout_order;
+// shared by all simulated ranks). Prints one
 // line: tiles, the block granule, total compute, the costliest tile, the ideal time at
 // RANKS ranks.
 #include <fmt/core.h>
@@ -136,11 +137,13 @@ int main(int argc, char** argv)
         put(out, job.points());
         out.write(reinterpret_cast<const char*>(cost.data()), static_cast<std::streamsize>(cost.size() * sizeof(double)));
         out.write(reinterpret_cast<const char*>(points.data()), static_cast<std::streamsize>(points.size() * sizeof(std::uint64_t)));
-        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) put(out, t);
-        if (!out) throw std::runtime_error(std::string("cannot write ") + argv[7]);
         // Blocks are multiples of this many tiles where they can be, as run_explore asks
-        // (one alignment unit of counts).
+        // (one alignment unit of counts), and the tiles are handed out in its order.
         const std::uint64_t granule = std::max<std::uint64_t>(1, job.alignment / (tiling.box(0).points() * count_bytes));
+        std::vector<std::uint64_t> pending(tiling.tiles());
+        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) pending[t] = t;
+        for (const std::uint64_t t : handout_order(pending, granule, ranks >= interleave_ranks_default)) put(out, t);
+        if (!out) throw std::runtime_error(std::string("cannot write ") + argv[7]);
         fmt::print("tiles={} tile_points={} granule={} compute_s={:.6g} costliest_tile_s={:.6g} ideal_s={:.6g}\n",
                    tiling.tiles(), tiling.box(0).points(), granule, total, worst, total / ranks);
         return 0;

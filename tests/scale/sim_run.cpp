@@ -10,7 +10,7 @@
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
 //       [--flush-bytes 6291456] [--journal-seconds 10]
-//       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--serve-every 0.05] [--trace]
+//       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--no-closing] [--serve-every 0.05] [--server-serve-every 0.005] [--trace] [--trace-bucket 1]
 #include <fcntl.h>
 #include <mpi.h>
 #include <smpi/smpi.h>
@@ -22,6 +22,7 @@
 #include <simgrid/s4u/Disk.hpp>
 #include <simgrid/s4u/Engine.hpp>
 #include <simgrid/s4u/Host.hpp>
+#include <simgrid/s4u/Mailbox.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -93,8 +94,12 @@ struct Options {
     double compress_mbps = 100;    // shuffle + deflate, per core
     double compress_ratio = 100;
     bool io = true;
+    bool closing = true;           // false: no closing pass (schedule experiments)
     bool trace = false;            // one line per rank on standard error (where the tail comes from)
+    double trace_bucket = 1;       // seconds: the waits between tiles summed over ranks by this
     double serve_every = 0.05;     // most compute seconds between two Serve calls (see ModelWork)
+    // The same for ranks that serve many (Serve::points below 512: node leaders).
+    double server_serve_every = 0.005;
 };
 
 Options parse(int argc, char** argv)
@@ -117,8 +122,11 @@ Options parse(int argc, char** argv)
         else if (a == "--compress-mbps") o.compress_mbps = std::stod(value());
         else if (a == "--compress-ratio") o.compress_ratio = std::stod(value());
         else if (a == "--no-io") o.io = false;
+        else if (a == "--no-closing") o.closing = false;
         else if (a == "--trace") o.trace = true;
+        else if (a == "--trace-bucket") o.trace_bucket = std::stod(value());
         else if (a == "--serve-every") o.serve_every = std::stod(value());
+        else if (a == "--server-serve-every") o.server_serve_every = std::stod(value());
         else if (o.costs.empty() && a.rfind("--", 0) != 0) o.costs = a;
         else throw std::runtime_error("unknown argument " + a);
     }
@@ -161,18 +169,84 @@ private:
     simgrid::s4u::Disk* disk_ = nullptr;
 };
 
+// The writer thread of a rank (io/partial_file.cpp, TileWriter): one buffer fills while
+// the other is written, so a rank waits for a write only when the next buffer is full
+// before the last one reached the file system, and when it flushes (every report period,
+// and when it is idle). Here an S4U actor on the rank's host, fed one job at a time.
+class WriterThread {
+public:
+    WriterThread(FileSystem& fs, int rank)
+        : fs_(fs),
+          jobs_(simgrid::s4u::Mailbox::by_name("writer-jobs-" + std::to_string(rank))),
+          acks_(simgrid::s4u::Mailbox::by_name("writer-acks-" + std::to_string(rank)))
+    {
+        simgrid::s4u::Actor::create("writer-" + std::to_string(rank), simgrid::s4u::this_actor::get_host(),
+                                    [this] { loop(); })
+            ->daemonize();
+    }
+    // The actor ends before this object: it runs on the rank's host until told.
+    ~WriterThread()
+    {
+        wait();
+        quit_ = true;
+        jobs_->put(&job_, 0);
+    }
+    WriterThread(const WriterThread&) = delete;
+    WriterThread& operator=(const WriterThread&) = delete;
+    // Starts writing `ops` (bytes of each write call) once the write before has ended.
+    void issue(const std::vector<double>& ops)
+    {
+        wait();
+        job_ = ops;
+        jobs_->put(&job_, 0);
+        busy_ = true;
+    }
+    void wait()
+    {
+        if (!busy_) return;
+        acks_->get<std::vector<double>>();
+        busy_ = false;
+    }
+
+private:
+    void loop()
+    {
+        for (;;) {
+            // The mailboxes only signal: SMPI's copy of message data does not carry S4U
+            // payloads, so the job is read from this object.
+            jobs_->get<std::vector<double>>();
+            if (quit_) return;
+            for (const double bytes : job_) fs_.write(bytes);
+            acks_->put(&job_, 0);
+        }
+    }
+
+    FileSystem& fs_;
+    simgrid::s4u::Mailbox* jobs_;
+    simgrid::s4u::Mailbox* acks_;
+    std::vector<double> job_;
+    bool quit_ = false;
+    bool busy_ = false;
+};
+
 // Counting replaced by smpi_execute of the tile's modelled cost, in pieces with the Serve
-// callback between them. The real counter calls it every 512 points; so does the model
-// where 512 points cost more than --serve-every seconds (a rank holding heavy tiles
-// answers requests for tiles back as late as the real one), and every --serve-every
-// seconds of compute elsewhere (fewer events: answers come later than in the real run by
-// at most that, never sooner);
-// writing by the writer's model: tiles buffered until ~6 MiB or a flush, then per run of
-// consecutive tiles one write to /wall_bounces and one to /outcome.
+// callback between them. The real counter calls it every Serve::points points (512, 64
+// on a node leader); so does the model where that many points cost more than
+// --serve-every seconds (--server-serve-every on a leader: a rank holding heavy tiles
+// answers as late as the real one), and every --serve-every seconds of compute elsewhere
+// (fewer events: answers come later than in the real run by at most that, never sooner);
+// writing as the writer does: tiles buffered until ~6 MiB, a tile that does not follow the
+// last, or a flush, then one write to /wall_bounces and one to /outcome on the writer
+// thread.
 class ModelWork final : public TileWork {
 public:
-    ModelWork(const Costs& c, FileSystem& fs, const Options& o)
-        : costs_(c), fs_(fs), flush_bytes_(o.flush_bytes), serve_every_(o.serve_every)
+    ModelWork(const Costs& c, FileSystem& fs, const Options& o, int rank)
+        : costs_(c),
+          writer_(fs, rank),
+          flush_bytes_(o.flush_bytes),
+          serve_every_(o.serve_every),
+          server_serve_every_(o.server_serve_every),
+          io_(o.io)
     {
     }
 
@@ -180,8 +254,21 @@ public:
     {
         const double cost = costs_.cost(tile);
         const std::uint64_t points = costs_.tile_points(tile);
-        const auto wanted = static_cast<std::uint64_t>(std::ceil(cost / serve_every_));
-        const int pieces = static_cast<int>(std::clamp<std::uint64_t>(wanted, 1, std::max<std::uint64_t>(1, points / 512)));
+        // Time since the last tile (waiting, scheduling, writing), by second of the run.
+        const double begin = MPI_Wtime();
+        if (begin > last_end) {
+            const auto second = static_cast<std::size_t>(std::max(0.0, last_end / bucket));
+            if (second >= gaps.size()) gaps.resize(second + 1, 0.0);
+            gaps[second] += begin - last_end;
+        }
+        // A tile that does not follow the buffered ones, or a full buffer, is written first.
+        const double bytes = static_cast<double>(points * costs_.bytes_per_point());
+        if (buffered_points_ > 0 && (tile != next_tile_ || buffered_bytes_ + bytes > flush_bytes_)) issue();
+        // A rank serving many calls Serve more often (schedule.hpp, Serve::points).
+        const double every = serve.points < 512 ? server_serve_every_ : serve_every_;
+        const auto wanted = static_cast<std::uint64_t>(std::ceil(cost / every));
+        const std::uint64_t most = std::max<std::uint64_t>(1, points / std::max<std::size_t>(1, serve.points));
+        const int pieces = static_cast<int>(std::clamp<std::uint64_t>(wanted, 1, most));
         for (int i = 0; i < pieces; ++i) {
             smpi_execute(cost / pieces);
             if (serve) serve();
@@ -189,21 +276,16 @@ public:
         busy += cost;
         ++tiles;
         last_end = MPI_Wtime();
-        if (!runs_.empty() && runs_.back().second == tile) {
-            ++runs_.back().second;
-        } else {
-            runs_.push_back({tile, tile + 1});
-        }
-        run_points_.resize(runs_.size());
-        run_points_.back() += points;
+        next_tile_ = tile + 1;
+        buffered_points_ += points;
         buffered_.push_back(tile);
-        buffered_bytes_ += static_cast<double>(points * costs_.bytes_per_point());
-        if (buffered_bytes_ >= flush_bytes_) write();
+        buffered_bytes_ += bytes;
     }
 
     std::vector<TileReport> flush() override
     {
-        write();
+        issue();
+        writer_.wait();
         std::vector<TileReport> out;
         for (const std::uint64_t t : written_) out.push_back({t, t});
         written_.clear();
@@ -212,31 +294,33 @@ public:
 
     double busy = 0;
     std::uint64_t tiles = 0;
-    double last_end = 0;
+    double last_end = 0;       // set to the start of the run before the first tile
+    double bucket = 1;         // of the gaps, in seconds
+    std::vector<double> gaps;  // seconds between tiles (and before the first), by bucket of the run their wait began
 
 private:
-    void write()
+    void issue()
     {
+        if (buffered_points_ == 0) return;
         const double count_bytes = static_cast<double>(costs_.bytes_per_point() - 1);
-        for (const std::uint64_t p : run_points_) {
-            fs_.write(static_cast<double>(p) * count_bytes);
-            fs_.write(static_cast<double>(p));
-        }
+        const double p = static_cast<double>(buffered_points_);
+        if (io_) writer_.issue({p * count_bytes, p});
         written_.insert(written_.end(), buffered_.begin(), buffered_.end());
         buffered_.clear();
-        runs_.clear();
-        run_points_.clear();
+        buffered_points_ = 0;
         buffered_bytes_ = 0;
     }
 
     const Costs& costs_;
-    FileSystem& fs_;
+    WriterThread writer_;
     double flush_bytes_;
     double serve_every_;
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> runs_;  // [first, end) of consecutive tiles
-    std::vector<std::uint64_t> run_points_;
+    double server_serve_every_;
+    bool io_;
+    std::uint64_t next_tile_ = 0;
+    std::uint64_t buffered_points_ = 0;
     std::vector<std::uint64_t> buffered_;
-    std::vector<std::uint64_t> written_;
+    std::vector<std::uint64_t> written_;  // issued; reported at the next flush, once written
     double buffered_bytes_ = 0;
 };
 
@@ -250,7 +334,7 @@ int run(int argc, char** argv)
     // process (smpi/privatization:no, so this static is shared), one after the other.
     static const Costs costs(o.costs);
     FileSystem fs(o);
-    ModelWork work(costs, fs, o);
+    ModelWork work(costs, fs, o, rank);
 
     // Rank 0's resume journal: the reports since the last one, every journal_seconds.
     std::uint64_t unjournaled = 0;
@@ -276,10 +360,23 @@ int run(int argc, char** argv)
     };
     world.barrier();
     const double start = MPI_Wtime();
+    work.last_end = start;
+    work.bucket = o.trace_bucket;
     const ScheduleResult r = run_schedule(world, costs.pending(), work, done, [] { return false; }, o.schedule);
     if (rank == 0) fs.write(16.0 * static_cast<double>(unjournaled) + 4096);
     const double scheduled = MPI_Wtime();
     if (o.trace) {
+        // Every rank's time between tiles, summed by second of the run: where the waits are.
+        const auto seconds = static_cast<std::size_t>(world.max(static_cast<double>(work.gaps.size())));
+        std::vector<double> gaps = work.gaps;
+        gaps.resize(seconds, 0.0);
+        mpi::check(MPI_Allreduce(MPI_IN_PLACE, gaps.data(), static_cast<int>(gaps.size()), MPI_DOUBLE, MPI_SUM, world.get()),
+                   "MPI_Allreduce");
+        if (rank == 0) {
+            std::fprintf(stderr, "trace waits by %g s of the run (rank-seconds between tiles):", o.trace_bucket);
+            for (std::size_t i = 0; i < gaps.size(); ++i) std::fprintf(stderr, " %g:%.1f", static_cast<double>(i) * o.trace_bucket, gaps[i]);
+            std::fprintf(stderr, "\n");
+        }
         std::fprintf(stderr, "trace rank=%d last_end=%.3f busy=%.3f tiles=%llu blocks=%llu given_back=%llu idle=%.3f leader=%d\n",
                      rank, work.last_end - start, work.busy, static_cast<unsigned long long>(r.stats.tiles),
                      static_cast<unsigned long long>(r.stats.blocks), static_cast<unsigned long long>(r.stats.given_back),
@@ -290,7 +387,7 @@ int run(int argc, char** argv)
     // writes the compressed result.
     world.barrier();
     const double raw = static_cast<double>(costs.points() * costs.bytes_per_point());
-    if (o.io) {
+    if (o.io && o.closing) {
         const double share = raw / ranks;
         fs.read(share);
         smpi_execute(share / (o.compress_mbps * 1e6));
@@ -299,28 +396,26 @@ int run(int argc, char** argv)
     world.barrier();
     const double end = MPI_Wtime();
 
-    const double last = r.stats.computed ? work.last_end : -1;
-    const std::vector<double> lasts = world.gather({last, static_cast<double>(r.stats.messages_in),
-                                                    static_cast<double>(fs.operations), scheduled - start,
-                                                    static_cast<double>(r.stats.given_back),
-                                                    r.stats.computed ? r.stats.idle_seconds : 0.0});
+    // Reductions, not a gather: SMPI's gather to one rank of 4096 waits on its requests one
+    // by one (minutes of wall time).
+    const auto reduce = [&](std::vector<double> v, MPI_Op op) {
+        mpi::check(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, op, world.get()),
+                   "MPI_Allreduce");
+        return v;
+    };
+    const double last = work.last_end;
+    const std::vector<double> mins = reduce({r.stats.computed ? last : 1e300}, MPI_MIN);
+    const std::vector<double> maxs =
+        reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start},
+               MPI_MAX);
+    const std::vector<double> sums = reduce({static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
+                                             r.stats.computed ? r.stats.idle_seconds : 0.0},
+                                            MPI_SUM);
     if (rank == 0) {
         double total = 0;
         for (std::uint64_t t = 0; t < costs.tiles(); ++t) total += costs.cost(t);
-        double first_idle = 1e300, last_busy = 0, leader_messages = 0, ops = 0, schedule_s = 0, given_back = 0, idle = 0;
-        for (int q = 0; q < ranks; ++q) {
-            const std::size_t at = 6 * static_cast<std::size_t>(q);
-            given_back += lasts[at + 4];
-            idle += lasts[at + 5];
-            const double l = lasts[at];
-            if (l >= 0) {
-                first_idle = std::min(first_idle, l);
-                last_busy = std::max(last_busy, l);
-            }
-            if (q != 0) leader_messages = std::max(leader_messages, lasts[at + 1]);
-            ops += lasts[at + 2];
-            schedule_s = std::max(schedule_s, lasts[at + 3]);
-        }
+        const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
+        const double ops = sums[0], given_back = sums[1], idle = sums[2];
         const double predicted = end - start;
         const double ideal = total / ranks;
         std::printf("ranks=%d efficiency=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "

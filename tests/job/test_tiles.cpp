@@ -1,0 +1,81 @@
+// The order in which a run hands out its tiles (job/tiles.hpp, handout_order).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include "job/tiles.hpp"
+
+namespace superball {
+namespace {
+
+std::vector<std::uint64_t> iota(std::uint64_t n)
+{
+    std::vector<std::uint64_t> v(n);
+    std::iota(v.begin(), v.end(), std::uint64_t{0});
+    return v;
+}
+
+TEST(HandoutOrder, NotInterleavedKeepsTheGridOrder)
+{
+    const std::vector<std::uint64_t> pending = iota(1000);
+    EXPECT_EQ(handout_order(pending, 8, false), pending);
+}
+
+TEST(HandoutOrder, ManyRanksTakeWholeGranulesInBitReversedOrder)
+{
+    // 8 granules of 4 tiles: granules 0 4 2 6 1 5 3 7, each in its own order.
+    const std::vector<std::uint64_t> order = handout_order(iota(32), 4, true);
+    const std::vector<std::uint64_t> granules{0, 4, 2, 6, 1, 5, 3, 7};
+    ASSERT_EQ(order.size(), 32u);
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        EXPECT_EQ(order[i], granules[i / 4] * 4 + i % 4) << "position " << i;
+    }
+}
+
+TEST(HandoutOrder, AnyPrefixOfAPowerOfTwoGranulesSpreadsOverTheGrid)
+{
+    // 1024 granules: the first 2^k granules handed out fall one in each 1/2^k of the grid.
+    const std::uint64_t granule = 16, granules = 1024;
+    const std::vector<std::uint64_t> order = handout_order(iota(granule * granules), granule, true);
+    for (std::uint64_t k = 1; k <= granules; k *= 2) {
+        std::vector<int> hits(k, 0);
+        for (std::uint64_t g = 0; g < k; ++g) ++hits[order[g * granule] / granule / (granules / k)];
+        EXPECT_TRUE(std::all_of(hits.begin(), hits.end(), [](int h) { return h == 1; })) << "first " << k << " granules";
+    }
+}
+
+TEST(HandoutOrder, EveryTileOnceAndIncompleteGranulesLast)
+{
+    // A resume: tiles done here and there leave some granules incomplete; the grid's last
+    // granule is short too (103 tiles, granule 8).
+    std::vector<std::uint64_t> pending;
+    for (std::uint64_t t = 0; t < 103; ++t) {
+        if (t != 17 && t != 18 && t != 60) pending.push_back(t);
+    }
+    const std::vector<std::uint64_t> order = handout_order(pending, 8, true);
+    std::vector<std::uint64_t> sorted = order;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, pending);
+    // Whole granules first, each a run of 8 consecutive tiles starting on a multiple of 8
+    // positions; then granules 2 (16, 19..23), 7 (56..59, 61..63) and 12 (96..102).
+    const std::size_t whole = order.size() - (6 + 7 + 7);
+    ASSERT_EQ(whole % 8, 0u);
+    for (std::size_t i = 0; i < whole; i += 8) {
+        EXPECT_EQ(order[i] % 8, 0u) << "position " << i;
+        for (std::size_t j = 1; j < 8; ++j) EXPECT_EQ(order[i + j], order[i] + j);
+    }
+    const std::vector<std::uint64_t> tail(order.begin() + static_cast<std::ptrdiff_t>(whole), order.end());
+    const std::vector<std::uint64_t> expected{16, 19, 20, 21, 22, 23, 56, 57, 58, 59, 61, 62, 63, 96, 97, 98, 99, 100, 101, 102};
+    EXPECT_EQ(tail, expected);
+}
+
+TEST(HandoutOrder, NothingPending)
+{
+    EXPECT_TRUE(handout_order({}, 8, true).empty());
+}
+
+}  // namespace
+}  // namespace superball
