@@ -20,6 +20,7 @@
 #include "job/job.hpp"
 #include "mpi/mpi.hpp"
 #include "result_metadata.hpp"
+#include "retained_tiles.hpp"
 
 namespace superball {
 
@@ -33,10 +34,20 @@ struct FinishReport {
     std::string sidecar_note;      // "sidecar: PATH", or why there is none
 };
 
+// Tiles kept in memory by the ranks that computed them (retained_tiles.hpp), for the
+// closing pass: the partial file's tiling, and this rank's store (null: none kept here).
+struct Retained {
+    const Tiling* tiling = nullptr;
+    const RetainedTiles* tiles = nullptr;
+};
+
 // Collective: writes the result of `job` at `output` from the partial file `partial`
 // (every tile done), with the run's figures; rank 0 then writes the XDMF sidecar and
-// removes the partial file. Returns on every rank.
+// removes the partial file. Returns on every rank. When some rank passes tiles it kept
+// (`retained`, the same tiling on every rank), each rank gathers its share of the result
+// whole before writing it: the tiles kept anywhere through one MPI_Alltoallv, the rest
+// read from the partial file; the share must then fit in memory (the caller decides).
 FinishReport write_result(const std::filesystem::path& partial, const std::filesystem::path& output, const Job& job,
-                          const Grid& grid, const mpi::Comm& comm, const RunFigures& run);
+                          const Grid& grid, const mpi::Comm& comm, const RunFigures& run, const Retained& retained = {});
 
 }  // namespace superball

@@ -230,6 +230,7 @@ void TileWriter::add(std::uint64_t tile, std::span<const std::uint32_t> counts, 
     }
     place(box.count, shape, outcomes.size(), [&](std::size_t dst, std::size_t src) { o[dst] = outcomes[src]; });
     b->reports.push_back({tile, tile_checksum(tile, counts_bytes, std::as_bytes(std::span(o, n)))});
+    if (retained_) retained_->add(tile, counts_bytes, std::as_bytes(std::span(o, n)));
     ++b->count;
 }
 

@@ -22,6 +22,7 @@
 #include "mpi/mpi.hpp"
 #include "page_buffer.hpp"
 #include "posix_file.hpp"
+#include "retained_tiles.hpp"
 
 namespace superball {
 
@@ -99,6 +100,9 @@ public:
     // Writes what is buffered and waits for every write; returns the tiles written since
     // the last call, with their checksums, in the order they were added.
     std::vector<TileReport> flush();
+    // From now on, every tile added is also kept in `store` while its budget lasts (for the
+    // closing pass, final_result.hpp). The store outlives the writer.
+    void retain(RetainedTiles& store) { retained_ = &store; }
 
 private:
     struct Buffer {
@@ -119,6 +123,7 @@ private:
     Buffer buffers_[2];
     int current_ = 0;
     std::vector<TileReport> written_;
+    RetainedTiles* retained_ = nullptr;
 };
 
 // Rank 0's record of finished tiles: kept in memory, written to the partial file's

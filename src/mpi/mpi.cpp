@@ -192,6 +192,37 @@ double Comm::max(double x) const
     return out;
 }
 
+std::vector<std::int32_t> Comm::max(const std::vector<std::int32_t>& v) const
+{
+    std::vector<std::int32_t> out(v.size());
+    check(MPI_Allreduce(v.data(), out.data(), static_cast<int>(v.size()), MPI_INT32_T, MPI_MAX, comm_), "MPI_Allreduce");
+    return out;
+}
+
+std::vector<std::byte> Comm::alltoallv(const std::vector<std::byte>& send, const std::vector<std::uint64_t>& send_counts,
+                                       const std::vector<std::uint64_t>& recv_counts) const
+{
+    const auto n = static_cast<std::size_t>(size());
+    if (send_counts.size() != n || recv_counts.size() != n) throw std::logic_error("alltoallv: one count per rank");
+    // MPI counts and displacements are ints.
+    const auto to_ints = [](const std::vector<std::uint64_t>& counts, std::vector<int>& c, std::vector<int>& at) {
+        std::uint64_t total = 0;
+        for (std::size_t r = 0; r < counts.size(); ++r) {
+            c[r] = static_cast<int>(counts[r]);
+            at[r] = static_cast<int>(total);
+            total += counts[r];
+            if (total >= (std::uint64_t{1} << 31)) throw std::length_error("alltoallv: 2 GiB or more to one rank");
+        }
+        return total;
+    };
+    std::vector<int> sc(n), sd(n), rc(n), rd(n);
+    if (to_ints(send_counts, sc, sd) > send.size()) throw std::logic_error("alltoallv: counts beyond the data");
+    std::vector<std::byte> out(to_ints(recv_counts, rc, rd));
+    check(MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_BYTE, out.data(), rc.data(), rd.data(), MPI_BYTE, comm_),
+          "MPI_Alltoallv");
+    return out;
+}
+
 std::vector<double> Comm::gather(const std::vector<double>& mine) const
 {
     const int n = static_cast<int>(mine.size());

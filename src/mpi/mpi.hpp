@@ -4,6 +4,7 @@
 
 #include <mpi.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -124,6 +125,13 @@ public:
     std::vector<std::uint64_t> sum(const std::vector<std::uint64_t>& v) const;
     // Largest value over ranks, on every rank.
     double max(double x) const;
+    // Element-wise largest value over ranks, on every rank.
+    std::vector<std::int32_t> max(const std::vector<std::int32_t>& v) const;
+    // Every rank sends send_counts[r] bytes of `send` (in rank order) to rank r and receives
+    // recv_counts[r] bytes from rank r: what it received, in rank order (MPI_Alltoallv).
+    // Each count and each total below 2^31 bytes.
+    std::vector<std::byte> alltoallv(const std::vector<std::byte>& send, const std::vector<std::uint64_t>& send_counts,
+                                     const std::vector<std::uint64_t>& recv_counts) const;
     // Every rank's values concatenated in rank order, on rank 0 (empty elsewhere).
     std::vector<double> gather(const std::vector<double>& mine) const;
 

@@ -433,7 +433,21 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     // the 4096^2 slice (1.54e8 against 2.03e8 points/s, medians of 5 interleaved runs); 2 MiB
     // was no faster and made more than 3 write calls per million points at 8192^2.
     const std::uint64_t buffer = std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment);
+    // The closing pass from memory (settings.closing_memory_ranks): decided alike on every
+    // rank, from the grid alone.
+    std::optional<RetainedTiles> kept;
+    {
+        // The largest share of the closing pass: whole result chunks, as many as the
+        // rank with the most gets.
+        const Tiling chunks(grid.shape(), default_tile_shape(grid.shape(), result_chunk_points));
+        const auto ranks = static_cast<std::uint64_t>(comm.size());
+        const std::uint64_t share = (chunks.tiles() + ranks - 1) / ranks * chunks.box(0).points() * (layout.count_bytes + 1);
+        if (comm.size() >= settings.closing_memory_ranks && share <= settings.closing_memory_bytes / 2) {
+            kept.emplace(layout.counts_chunk(), layout.outcomes_chunk(), settings.closing_memory_bytes / 2);
+        }
+    }
     TileWriter writer(file, buffer);
+    if (kept) writer.retain(*kept);
     Work work(job, grid, writer, tiling, settings.kernel);
     const TilesDone on_done = [&](std::span<const TileReport> tiles, int) {
         journal->record(tiles);
@@ -472,7 +486,8 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     total_seconds = comm.broadcast(total_seconds);
     if (!r.interrupted) {
         if (comm.is_root()) observer.finishing();
-        const FinishReport f = write_result(partial, plan.output, job, grid, comm, {comm.size(), total_seconds, true});
+        const Retained retained{kept ? &tiling : nullptr, kept ? &*kept : nullptr};
+        const FinishReport f = write_result(partial, plan.output, job, grid, comm, {comm.size(), total_seconds, true}, retained);
         summary.finish_seconds = f.seconds;
         summary.raw_bytes = f.raw_bytes;
         summary.result_bytes = f.file_bytes;

@@ -36,6 +36,14 @@ struct ExploreSettings {
     // From this many ranks on, tiles are handed out interleaved (job/tiles.hpp,
     // handout_order); tests set 1 to interleave at any rank count.
     int interleave_ranks = interleave_ranks_default;
+    // From this many ranks on, each rank keeps the tiles it computes in memory for the
+    // closing pass (io/retained_tiles.hpp), if its share of the result fits in half of
+    // closing_memory_bytes; its tiles are kept up to the other half, the rest read back
+    // from the partial file. (Below it the closing pass reads the partial file: on one
+    // machine it mostly comes from the page cache, and a rank's memory stays the same
+    // whatever the grid.) Tests set 1 to keep tiles at any rank count.
+    int closing_memory_ranks = 64;
+    std::uint64_t closing_memory_bytes = std::uint64_t{512} << 20;
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]

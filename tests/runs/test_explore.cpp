@@ -206,6 +206,26 @@ TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
     EXPECT_TRUE(third.nothing_to_do);
 }
 
+// Runs `job` with `s` (not resuming), stopped by rank 0 when it has been asked 1/`part` of
+// the tiles' count times (it is asked between its tiles), then resumes it: the result is `want`.
+void expect_stopped_and_resumed(const Job& job, ExploreSettings s, const Data& want, std::uint64_t part)
+{
+    Tally first;
+    std::uint64_t polls = 0;
+    const StopRequested stop = [&] { return world.is_root() && first.start.tiles > 0 && ++polls > first.start.tiles / part; };
+    EXPECT_TRUE(run_explore(job, s, world, first, stop).interrupted);
+    s.resume = true;
+    Tally second;
+    EXPECT_TRUE(run_explore(job, s, world, second, never).complete);
+    if (world.is_root()) {
+        EXPECT_GT(second.start.tiles_done, 0u);
+        EXPECT_EQ(second.start.tiles_done + second.tiles, second.start.tiles);
+        const Data got = read_result(s.output);
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+    }
+}
+
 // Tiles handed out interleaved (as from 64 ranks on, job/tiles.hpp handout_order), here at
 // any rank count: the same result, and a stopped run resumes to it (its incomplete
 // granules go last).
@@ -228,20 +248,36 @@ TEST(RunExplore, InterleavedHandoutGivesTheSameResultAndResumes)
         EXPECT_EQ(got.outcomes, want.outcomes);
     }
     s.output = dir / "stopped.h5";
-    Tally first;
-    std::uint64_t polls = 0;
-    const StopRequested stop = [&] { return world.is_root() && first.start.tiles > 0 && ++polls > first.start.tiles / 10; };
-    EXPECT_TRUE(run_explore(job, s, world, first, stop).interrupted);
-    s.resume = true;
-    Tally second;
-    EXPECT_TRUE(run_explore(job, s, world, second, never).complete);
-    if (world.is_root()) {
-        EXPECT_GT(second.start.tiles_done, 0u);
-        EXPECT_EQ(second.start.tiles_done + second.tiles, second.start.tiles);
-        const Data got = read_result(dir / "stopped.h5");
-        EXPECT_EQ(got.counts, want.counts);
-        EXPECT_EQ(got.outcomes, want.outcomes);
+    expect_stopped_and_resumed(job, s, want, 10);
+}
+
+// The closing pass from the tiles the ranks kept in memory (as from 64 ranks on,
+// ExploreSettings::closing_memory_ranks), here at any rank count: the same result; after a
+// resume the tiles of the first run come from the file, the others from memory.
+TEST(RunExplore, ClosingPassFromMemoryGivesTheSameResult)
+{
+    const SharedDir dir;
+    // 2^19 points: two result chunks of 2^18, 2048 tiles of 256 points.
+    const Job job = parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 1024 }\nU = -1.0\n"
+                              "W = { min = -3.0, max = 3.0, n = 512 }\n[run]\nmax_bounces = 1000\ntile_points = 256\n"
+                              "checkpoint_seconds = 0.01\n",
+                              "closing job");
+    const Data want = direct(job);
+    for (const int interleave : {1, interleave_ranks_default}) {
+        ExploreSettings s = settings(dir / "memory.h5", false, true);
+        s.closing_memory_ranks = 1;
+        s.interleave_ranks = interleave;
+        Tally tally;
+        EXPECT_TRUE(run_explore(job, s, world, tally, never).complete);
+        if (world.is_root()) {
+            const Data got = read_result(dir / "memory.h5");
+            EXPECT_EQ(got.counts, want.counts) << "interleave from " << interleave << " ranks";
+            EXPECT_EQ(got.outcomes, want.outcomes) << "interleave from " << interleave << " ranks";
+        }
     }
+    ExploreSettings s = settings(dir / "resumed.h5");
+    s.closing_memory_ranks = 1;
+    expect_stopped_and_resumed(job, s, want, 20);
 }
 
 TEST(RunExplore, RefinementDoesNotDependOnTheRankCount)

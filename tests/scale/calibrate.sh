@@ -45,7 +45,7 @@ job trivial_small 1024 $'e = 0.9\nalpha = 0.9' "$trivial_grid" 1000
 job garwin 0 $'e = 1.0\nalpha = 1.0' $'xi = { min = 0.0, max = 1.0, n = 64 }\nU = { min = -3.0, max = 0.0, n = 64 }\nW = { min = -3.0, max = 3.0, n = 64 }' 20000
 
 computed() {  # the compute-phase seconds of one run at -n 1
-  mpirun -n 1 "$superball" explore "$work/$1.toml" --overwrite -q 2>&1 | sed -n 's/.*computed in \([0-9.]*\) s.*/\1/p'
+  tests/scale/computed.sh "$superball" "$work/$1.toml" 1 2>/dev/null
 }
 declare -A times
 for ((r = 0; r < reps; r++)); do

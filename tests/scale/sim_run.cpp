@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include <simgrid/s4u/Actor.hpp>
+#include <simgrid/s4u/Comm.hpp>
 #include <simgrid/s4u/Disk.hpp>
 #include <simgrid/s4u/Engine.hpp>
 #include <simgrid/s4u/Host.hpp>
@@ -383,13 +384,28 @@ int run(int argc, char** argv)
                      r.stats.idle_seconds, r.stats.leader ? 1 : 0);
     }
 
-    // The closing pass: every rank reads back its share of the raw data, compresses it and
-    // writes the compressed result.
+    // The closing pass: every rank gathers its share of the raw data, compresses it and
+    // writes the compressed result. From 64 ranks on, when a share fits in 256 MiB
+    // (run/explore.hpp, ExploreSettings::closing_memory_*), the ranks that computed the tiles
+    // send them (modelled as one exchange of a share with a rank of another node: every node
+    // sends and receives its ranks' shares over its link); otherwise each rank reads its share
+    // back from the file system.
     world.barrier();
     const double raw = static_cast<double>(costs.points() * costs.bytes_per_point());
     if (o.io && o.closing) {
         const double share = raw / ranks;
-        fs.read(share);
+        if (ranks >= 64 && share <= double(std::uint64_t{256} << 20)) {
+            // Sizes without data: an S4U message of the share's size to a rank half the
+            // machine away, and one from the rank as far the other way.
+            const auto to = simgrid::s4u::Mailbox::by_name("closing-" + std::to_string((rank + ranks / 2) % ranks));
+            const auto from = simgrid::s4u::Mailbox::by_name("closing-" + std::to_string(rank));
+            static char token = 0;
+            const simgrid::s4u::CommPtr sent = to->put_async(&token, static_cast<std::uint64_t>(share));
+            from->get<char>();
+            sent->wait();
+        } else {
+            fs.read(share);
+        }
         smpi_execute(share / (o.compress_mbps * 1e6));
         fs.write(share / o.compress_ratio);
     }

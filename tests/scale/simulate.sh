@@ -18,7 +18,7 @@
 # The model, step by step:
 #   1. the job at a lower resolution (tests/scale/lowres_job.py: about 2 million points),
 #      computed here with the real superball at -n 1 (once; kept in OUT/lowres with its
-#      compute time);
+#      compute time, the median of 3 runs: run it on a machine doing nothing else);
 #   2. the cost of each tile of the job as `superball explore` tiles it for N ranks
 #      (scale_costs): per point NS_PER_POINT + NS_PER_ITERATION x its wall bounces (from the
 #      nearest low-resolution sample), plus US_PER_TILE. NS_PER_POINT and US_PER_TILE were
@@ -83,10 +83,9 @@ for job in "${jobs[@]}"; do
   /usr/bin/python3 tests/scale/lowres_job.py "$job" "$out/lowres/$name.next.toml" "$out/lowres/$name.h5"
   if ! cmp -s "$out/lowres/$name.next.toml" "$out/lowres/$name.toml" || [[ ! -f $out/lowres/$name.seconds ]]; then
     mv "$out/lowres/$name.next.toml" "$out/lowres/$name.toml"
-    echo "simulate: computing $out/lowres/$name.toml at -n 1" >&2
-    mpirun -n 1 "$superball" explore "$out/lowres/$name.toml" --overwrite 2>&1 |
-      sed -n 's/.* computed in \([0-9.]*\) s.*/\1/p' >"$out/lowres/$name.seconds"
-    [[ -s $out/lowres/$name.seconds ]] || { rm -f "$out/lowres/$name.seconds"; echo "simulate: $out/lowres/$name.toml failed" >&2; exit 1; }
+    echo "simulate: computing $out/lowres/$name.toml at -n 1 (3 runs; on a machine doing nothing else)" >&2
+    tests/scale/computed.sh "$superball" "$out/lowres/$name.toml" 3 >"$out/lowres/$name.seconds" ||
+      { rm -f "$out/lowres/$name.seconds"; echo "simulate: $out/lowres/$name.toml failed" >&2; exit 1; }
   else
     rm "$out/lowres/$name.next.toml"
   fi

@@ -58,11 +58,10 @@ max_bounces = 1000
 output = "$out/trivial.h5"
 tile_points = 1024
 EOF
-cases=("jobs/full/volume.toml:1 2" "$out/zoom.toml:1 2 4" "$out/trivial.toml:4 8")
+cases=("jobs/full/volume.toml:1 2" "$out/zoom.toml:1 2 4" "$out/trivial.toml:2 4 8")
 
-computed() {  # compute-phase seconds of a real run: JOB RANKS
-  mpirun -n "$2" --oversubscribe "$superball" explore "$1" -o "$out/real.h5" --overwrite -q 2>&1 |
-    sed -n 's/.*computed in \([0-9.]*\) s.*/\1/p'
+computed() {  # compute-phase seconds of real runs, the median of REPS: JOB RANKS
+  tests/scale/computed.sh "$superball" "$1" "$reps" "$2" "$out/real.h5"
 }
 predicted() {  # schedule_s of the simulation: NAME JOB RANKS NS_PER_ITERATION
   local granule
@@ -83,16 +82,14 @@ for c in "${cases[@]}"; do
   /usr/bin/python3 tests/scale/lowres_job.py "$job" "$out/$name.low.toml" "$out/$name.low.h5" \
     --points "$(( $("$superball" explore "$job" --dry-run | sed -n 's/^points: //p') / 8 ))"
   # Computed at -n 1: its compute time gives the job's cost per wall bounce, as in simulate.sh.
-  seconds=$(computed "$out/$name.low.toml" 1)
+  seconds=$(computed "$out/$name.low.toml" 1 2>/dev/null)
   mv "$out/real.h5" "$out/$name.low.h5"
   tiles=$("$superball" explore "$out/$name.low.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
   read -r ns_per_iteration _ < <(/usr/bin/python3 tests/scale/sample_model.py "$out/$name.low.h5" "$seconds" "$tiles" \
     "$NS_PER_POINT" "$US_PER_TILE" "$NS_PER_ITERATION")
   for n in ${c#*:}; do
-    times=()
-    for ((r = 0; r < reps; r++)); do times+=("$(computed "$job" "$n")"); done
-    real=$(printf '%s\n' "${times[@]}" | sort -g | sed -n "$(( (reps + 1) / 2 ))p")
+    real=$(computed "$job" "$n" 2>"$out/$name.$n.real")
     model=$(predicted "$name" "$job" "$n" "$ns_per_iteration")
-    /usr/bin/python3 -c "print(f'job=$name ranks=$n real_s=$real predicted_s={$model:.3f} error={($model - $real) / $real:+.1%}  (real runs: ${times[*]}; ns_per_iteration=$ns_per_iteration)')"
+    /usr/bin/python3 -c "print(f'job=$name ranks=$n real_s=$real predicted_s={$model:.3f} error={($model - $real) / $real:+.1%}  ($(sed 's/computed.sh: /real runs: /' "$out/$name.$n.real"); sample {$seconds} s; ns_per_iteration=$ns_per_iteration)')"
   done
 done
