@@ -185,7 +185,8 @@ std::vector<BoxData> gather_share(const mpi::Comm& comm, const Retained& retaine
     for (const std::uint64_t t : kept) owner[t] = me;
     owner = comm.max(owner);
 
-    const auto tile_counts = [&](std::uint64_t t) { return retained.tiles->find(t); };
+    // A kept tile's chunk of counts, its chunk of outcomes after it.
+    const auto chunk_of = [&](std::uint64_t t) { return retained.tiles->find(t); };
     const std::uint64_t counts_chunk = retained.tiles ? retained.tiles->counts_chunk() : 0;
 
     // This rank's boxes: from the file where a tile nobody kept meets them, then the tiles
@@ -204,7 +205,7 @@ std::vector<BoxData> gather_share(const mpi::Comm& comm, const Retained& retaine
             const Box part = intersect(tiling.box(t), b);
             if (owner[t] == me) {
                 const Box tb = tiling.box(t);
-                const std::byte* chunk = tile_counts(t);
+                const std::byte* chunk = chunk_of(t);
                 copy_box(part, chunk, tb.start, tile_shape, data[i].counts.data(), b.start, b.count, count_bytes);
                 copy_box(part, chunk + counts_chunk, tb.start, tile_shape, data[i].outcomes.data(), b.start, b.count, 1);
             } else if (owner[t] >= 0) {
@@ -251,7 +252,7 @@ std::vector<BoxData> gather_share(const mpi::Comm& comm, const Retained& retaine
     for (std::uint64_t r = 0; r < ranks; ++r) {
         for (const Part& p : to[r]) {
             const Box tb = tiling.box(p.tile);
-            const std::byte* chunk = tile_counts(p.tile);
+            const std::byte* chunk = chunk_of(p.tile);
             copy_box(p.part, chunk, tb.start, tile_shape, out, p.part.start, p.part.count, count_bytes);
             out += p.part.points() * count_bytes;
             copy_box(p.part, chunk + counts_chunk, tb.start, tile_shape, out, p.part.start, p.part.count, 1);
@@ -288,13 +289,15 @@ std::uint64_t size_of(const fs::path& p)
 
 }  // namespace
 
+Tiling result_chunks(const Extent& shape) { return Tiling(shape, default_tile_shape(shape, result_chunk_points)); }
+
 FinishReport write_result(const fs::path& partial, const fs::path& output, const Job& job, const Grid& grid,
                           const mpi::Comm& comm, const RunFigures& run, const Retained& retained)
 {
     const auto started = std::chrono::steady_clock::now();
     const fs::path tmp = layout::finishing_path(output);
     const Extent shape = grid.shape();
-    const Tiling chunks(shape, default_tile_shape(shape, result_chunk_points));
+    const Tiling chunks = result_chunks(shape);
     const hid_t counts_type = count_type(job);
     const hid_t counts_memory = H5Tget_size(counts_type) == 2 ? H5T_NATIVE_UINT16 : H5T_NATIVE_UINT32;
     const std::size_t count_bytes = H5Tget_size(counts_type);
@@ -315,7 +318,7 @@ FinishReport write_result(const fs::path& partial, const fs::path& output, const
         // the rank with the most, selecting nothing once its share is done.
         const auto ranks = static_cast<std::uint64_t>(comm.size());
         const std::uint64_t most = std::max<std::uint64_t>(1, (std::uint64_t{8} << 20) / (chunk_points * (count_bytes + 1)));
-        std::map<int, std::vector<ChunkBox>> shares;  // by rank, computed when asked for
+        std::map<int, std::vector<ChunkBox>> shares;  // by rank, each computed once
         const auto share = [&](int r) -> const std::vector<ChunkBox>& {
             auto it = shares.find(r);
             if (it == shares.end()) {
@@ -324,12 +327,9 @@ FinishReport write_result(const fs::path& partial, const fs::path& output, const
             }
             return it->second;
         };
-        const std::vector<ChunkBox> mine = share(comm.rank());
-        // Every share has the same number of chunks give or take one, and so of boxes give
-        // or take the rows they cross: the most is among the shares of the most chunks.
+        const std::vector<ChunkBox>& mine = share(comm.rank());
         std::size_t rounds = 0;
-        for (std::uint64_t r = 0; r < ranks; ++r) rounds = std::max(rounds, boxes_of(chunks, chunks.tiles() * r / ranks,
-                                                                                      chunks.tiles() * (r + 1) / ranks, most).size());
+        for (int r = 0; r < comm.size(); ++r) rounds = std::max(rounds, share(r).size());
         const auto read = [&](const Box& b, BoxData& d) {
             const h5::Id file_space = h5::space_id(H5Dget_space(counts_in), "H5Dget_space");
             h5::select_box(file_space, to_hsize(b.start), to_hsize(b.count));

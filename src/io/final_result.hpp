@@ -27,6 +27,10 @@ namespace superball {
 // Points of a result chunk: 2^18, i.e. 512 KiB of 16-bit counts and 256 KiB of outcomes.
 inline constexpr std::uint64_t result_chunk_points = std::uint64_t{1} << 18;
 
+// The chunks of a result of this grid shape, as tiles (the closing pass shares them out
+// among the ranks in contiguous runs of chunk numbers).
+Tiling result_chunks(const Extent& shape);
+
 struct FinishReport {
     std::uint64_t raw_bytes = 0;   // of the data uncompressed
     std::uint64_t file_bytes = 0;  // of the result file

@@ -439,7 +439,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     {
         // The largest share of the closing pass: whole result chunks, as many as the
         // rank with the most gets.
-        const Tiling chunks(grid.shape(), default_tile_shape(grid.shape(), result_chunk_points));
+        const Tiling chunks = result_chunks(grid.shape());
         const auto ranks = static_cast<std::uint64_t>(comm.size());
         const std::uint64_t share = (chunks.tiles() + ranks - 1) / ranks * chunks.box(0).points() * (layout.count_bytes + 1);
         if (comm.size() >= settings.closing_memory_ranks && share <= settings.closing_memory_bytes / 2) {
