@@ -12,6 +12,7 @@ import itertools
 import math
 import os
 import sys
+import zlib
 
 import h5py
 import numpy as np
@@ -184,8 +185,11 @@ def iter_blocks(shape, max_elements):
             yield tuple(lead) + (slice(start, min(start + run, shape[cut])),) + rest
 
 
-# The file layout (src/io/layout.hpp): what superball 0.2 writes and this module reads.
-FORMAT_VERSION = 2
+# The file layout (src/io/layout.hpp): what superball writes and this module reads.
+# Format 3: partial files may hold compressed tiles past their HDF5 objects
+# (/progress/tile_stored); results are laid out as in format 2, which is still read.
+FORMAT_VERSION = 3
+OLDEST_RESULT_FORMAT = 2
 KIND_RESULT, KIND_PARTIAL = "result", "partial"
 COEFFICIENT_NAMES = ("e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor")
 # Limits of a sound file, as the C++ reader's (src/io/result_reader.cpp): beyond 2^40
@@ -315,10 +319,20 @@ def damaged_global_heap(path, skip):
 
 def raw_data_ranges(file):
     """Byte ranges (offset, size) of a file's big raw data, which damaged_global_heap need
-    not search: contiguous datasets, and chunked ones without filters whose chunks lie one
-    after the other (a partial file's)."""
+    not search: contiguous datasets, chunked ones without filters whose chunks lie one
+    after the other (an uncompressed partial file's), and the tiles a compressed partial
+    file records done."""
     ranges = []
-    for name in ("wall_bounces", "outcome", "progress/tile_done", "progress/tile_checksum"):
+    try:
+        done, stored = file.get("progress/tile_done"), file.get("progress/tile_stored")
+        if (isinstance(done, h5py.Dataset) and isinstance(stored, h5py.Dataset) and done.ndim == 1
+                and stored.shape == (done.shape[0], 3) and done.shape[0] <= MAX_POINTS):
+            flags, where = done[()], stored[()].astype(np.uint64)
+            for t in np.flatnonzero(flags == 1):
+                ranges.append((int(where[t, 0]), int(where[t, 1]) + int(where[t, 2])))
+    except H5PY_ERRORS:
+        pass
+    for name in ("wall_bounces", "outcome", "progress/tile_done", "progress/tile_checksum", "progress/tile_stored"):
         try:
             dataset = file.get(name)
             if not isinstance(dataset, h5py.Dataset) or 0 in (dataset.shape or (0,)):
@@ -527,9 +541,12 @@ class Result:
         if self.kind not in (KIND_RESULT, KIND_PARTIAL):
             self.fail(f'attribute superball_file = "{printable(self.kind)}" is neither "result" nor "partial"')
         version = self._integer("superball_format", 0, 2**63 - 1)
-        if version != FORMAT_VERSION:
-            self.fail(f"attribute superball_format = {version}: this version of superball reads format "
-                      f"{FORMAT_VERSION} only; read the file with the version that wrote it")
+        if version != FORMAT_VERSION and not (self.kind == KIND_RESULT and OLDEST_RESULT_FORMAT <= version < FORMAT_VERSION):
+            if self.kind == KIND_RESULT:
+                self.fail(f"attribute superball_format = {version}: this version of superball reads results of format "
+                          f"{OLDEST_RESULT_FORMAT} to {FORMAT_VERSION}; read the file with the version that wrote it")
+            self.fail(f"attribute superball_format = {version}: a partial file of format {version} is resumed by the "
+                      f"version that wrote it, this one resumes format {FORMAT_VERSION} only")
 
         self.coordinates = self._text("coordinate_system")
         if self.coordinates not in COORDINATE_NAMES:
@@ -592,19 +609,19 @@ class Result:
                     self.fail(f"attribute {key} = {format_number(value)} is out of range: accepted > 0")
                 self._model[key] = value
 
+        if self.kind == KIND_RESULT and "progress" in self.file:
+            journal = " (/progress), which only a run in progress has"
+            flags = self.file.get("progress/tile_done")
+            if isinstance(flags, h5py.Dataset) and flags.dtype.kind in "ui" and flags.ndim == 1:
+                flags = flags[()]
+                journal = f", /progress/tile_done, recording {int(np.count_nonzero(flags == 1))} of {flags.size} tiles done"
+            self.fail("superball_file = result and complete = 1 say the run is complete, but the file holds a "
+                      f"resume journal{journal}: the file contradicts itself")
         self._validate_data()
         if self.kind == KIND_PARTIAL:
             self._validate_partial()
         else:
             self.tile_shape, self.tile_count, self.tiles_done, self._done = None, 1, 1, None
-            if "progress" in self.file:
-                journal = " (/progress), which only a run in progress has"
-                flags = self.file.get("progress/tile_done")
-                if isinstance(flags, h5py.Dataset) and flags.dtype.kind in "ui" and flags.ndim == 1:
-                    flags = flags[()]
-                    journal = f", /progress/tile_done, recording {int(np.count_nonzero(flags == 1))} of {flags.size} tiles done"
-                self.fail("superball_file = result and complete = 1 say the run is complete, but the file holds a "
-                          f"resume journal{journal}: the file contradicts itself")
 
     def _validate_data(self):
         self.counts = self._dataset("/wall_bounces")
@@ -633,8 +650,9 @@ class Result:
             self.fail(f"/wall_bounces {shape} has more than 2^40 points")
         if self.max_bounces > 65535 and self.counts.dtype.itemsize == 2:
             self.fail(f"max_bounces = {self.max_bounces} does not fit the 16-bit counts of /wall_bounces")
-        self._allocated(self.counts, "/wall_bounces")
-        self._allocated(self.outcomes, "/outcome")
+        if not partial:  # a compressed partial file's chunks are indexed when it becomes the result
+            self._allocated(self.counts, "/wall_bounces")
+            self._allocated(self.outcomes, "/outcome")
 
         scales = {name: self._scales(dataset, name) for name, dataset in
                   (("/wall_bounces", self.counts), ("/outcome", self.outcomes))}
@@ -700,24 +718,48 @@ class Result:
                       f"({', '.join(map(str, shape))})")
         self._tiles_per_axis = [-(-n // t) for n, t in zip(shape, self.tile_shape)]
         self.tile_count = math.prod(self._tiles_per_axis)
+        # One chunk per tile: uncompressed, each tile written straight to its chunk;
+        # compressed, shuffle + deflate as in the result, the chunks appended past the HDF5
+        # objects (listed in /progress/tile_stored) and not indexed yet.
+        pipelines = []
         for name, dataset in (("/wall_bounces", self.counts), ("/outcome", self.outcomes)):
             plist = dataset.id.get_create_plist()
             chunks = plist.get_chunk() if plist.get_layout() == h5py.h5d.CHUNKED else None
-            if chunks is None or list(chunks) != self.tile_shape or plist.get_nfilters():
+            filters = [plist.get_filter(i)[0] for i in range(plist.get_nfilters())]
+            level = None
+            if filters == [h5py.h5z.FILTER_SHUFFLE, h5py.h5z.FILTER_DEFLATE]:
+                values = plist.get_filter(1)[2]
+                level = int(values[0]) if len(values) else 0
+            pipelines.append(filters)
+            if (chunks is None or list(chunks) != self.tile_shape or
+                    not (filters == [] or (level is not None and 1 <= level <= 9))):
                 stored = "unchunked" if chunks is None else f"in chunks of ({', '.join(map(str, chunks))})"
-                if chunks is not None and plist.get_nfilters():
-                    stored += f" through {plist.get_nfilters()} filters"
-                self.fail(f"{name} is stored {stored}, not in uncompressed chunks of tile_shape "
-                          f"({', '.join(map(str, self.tile_shape))}) as a partial file is")
+                if chunks is not None and filters:
+                    stored += f" through {len(filters)} filters"
+                self.fail(f"{name} is stored {stored}, not in chunks of tile_shape ({', '.join(map(str, self.tile_shape))}), "
+                          "uncompressed or through shuffle and deflate alike for both datasets, as a partial file is")
+            if not filters:
+                self._allocated(dataset, name)
+            elif dataset.id.get_num_chunks():
+                self.fail(f"{name} holds chunks ({dataset.id.get_num_chunks()}), which a compressed partial file never "
+                          "does: its tiles are in /progress/tile_stored until the run completes; the file is damaged")
+        self._compressed = bool(pipelines[0])
+        if pipelines[0] != pipelines[1]:
+            self.fail("/outcome is stored otherwise than /wall_bounces, not in chunks of tile_shape "
+                      f"({', '.join(map(str, self.tile_shape))}), uncompressed or through shuffle and deflate alike for "
+                      "both datasets, as a partial file is")
         journal = {}
-        for name, size in (("/progress/tile_done", 1), ("/progress/tile_checksum", 8)):
+        names = [("/progress/tile_done", 1, (self.tile_count,)), ("/progress/tile_checksum", 8, (self.tile_count,))]
+        if self._compressed:
+            names.append(("/progress/tile_stored", 8, (self.tile_count, 3)))
+        for name, size, want in names:
             dataset = self._dataset(name)
             type_class, bytes_, signed, little = self._type(dataset)
             if (type_class != h5py.h5t.INTEGER or signed or bytes_ != size or not little
-                    or dataset.shape != (self.tile_count,)):
+                    or dataset.shape != want):
                 self.fail(f"{name} holds {shape_text(type_class, dataset.shape)} but tile_shape "
                           f"({', '.join(map(str, self.tile_shape))}) makes {self.tile_count} tiles: accepted "
-                          f"{self.tile_count} unsigned {8 * size}-bit integers, one per tile")
+                          f"({', '.join(map(str, want))}) unsigned {8 * size}-bit integers")
             self._allocated(dataset, name)
             journal[name] = dataset[()]
         self._done = journal["/progress/tile_done"].astype(np.uint8)
@@ -726,6 +768,16 @@ class Result:
         if bad.size:
             self.fail(f"/progress/tile_done holds {self._done[bad[0]]} for tile {bad[0]}: accepted 0 or 1")
         self.tiles_done = int(np.count_nonzero(self._done))
+        self._stored = None
+        if self._compressed:
+            self._stored = journal["/progress/tile_stored"].astype(np.uint64)
+            size = os.path.getsize(self.path)
+            chunk_bytes = math.prod(self.tile_shape) * self.counts.dtype.itemsize
+            for t in np.flatnonzero(self._done == 1):
+                at, nc, no = (int(v) for v in self._stored[t])
+                if nc == 0 or no == 0 or nc > chunk_bytes + chunk_bytes // 2 + 64 or no > chunk_bytes or at + nc + no > size:
+                    self.fail(f"/progress/tile_stored places done tile {t} at bytes {at} to {at + nc} (+{no}), which a "
+                              f"file of {size} bytes cannot hold: the file is truncated or damaged")
 
     # --- values ---------------------------------------------------------------------------
 
@@ -735,16 +787,22 @@ class Result:
         invalid; an outcome code outside 0-3, a count its outcome does not allow, a damaged tile
         or unreadable data is a ScriptError naming the object and the point or tile."""
         index = tuple(index)
-        try:
-            counts = np.asarray(self.counts[index])
-            outcomes = np.asarray(self.outcomes[index])
-        except H5PY_ERRORS as error:
-            self.fail(f"/wall_bounces or /outcome cannot be read at {index_text(index)} ({error}); the file is damaged")
         # Per dimension, the file indices the block holds; kept: the dimensions not indexed by an int.
         positions = [np.arange(n)[i] if isinstance(i, slice) else np.array([int(i) % n])
                      for i, n in zip(index, self.shape)]
         expanded = tuple(len(p) for p in positions)
-        counts_full, outcomes_full = counts.reshape(expanded), outcomes.reshape(expanded).copy()
+        kept = tuple(len(p) for p, i in zip(positions, index) if isinstance(i, slice))
+        if self.kind == KIND_PARTIAL and self._compressed:
+            self._verify_tiles(positions)
+            counts_full, outcomes_full = self._read_stored(positions)
+            counts, outcomes = counts_full.reshape(kept), outcomes_full.reshape(kept)
+        else:
+            try:
+                counts = np.asarray(self.counts[index])
+                outcomes = np.asarray(self.outcomes[index])
+            except H5PY_ERRORS as error:
+                self.fail(f"/wall_bounces or /outcome cannot be read at {index_text(index)} ({error}); the file is damaged")
+            counts_full, outcomes_full = counts.reshape(expanded), outcomes.reshape(expanded).copy()
         if self.kind == KIND_PARTIAL:
             self._verify_tiles(positions)
             tiles = [p // t for p, t in zip(positions, self.tile_shape)]
@@ -780,6 +838,38 @@ class Result:
             self.fail(f"/wall_bounces holds {int(counts[at])} at {where(bad)} with outcome {code} "
                       f"({OUTCOME_NAMES[code]}), which allows {allowed}; the file is damaged")
 
+    def _read_stored(self, positions):
+        """A compressed partial file's values at `positions` (file indices per dimension):
+        each done tile the block meets decompressed from its stored chunks (zlib, then the
+        shuffle undone), the others zeros."""
+        counts = np.zeros(tuple(len(p) for p in positions), dtype=self.counts.dtype)
+        outcomes = np.zeros(counts.shape, dtype=np.uint8)
+        tiles = [np.unique(p // t) for p, t in zip(positions, self.tile_shape)]
+        points = math.prod(self.tile_shape)
+        width = self.counts.dtype.itemsize
+        with open(self.path, "rb") as f:
+            for coords in itertools.product(*tiles):
+                tile = int(np.ravel_multi_index(coords, self._tiles_per_axis))
+                if self._done[tile] == 0:
+                    continue
+                at, nc, no = (int(v) for v in self._stored[tile])
+                f.seek(at)
+                stored = f.read(nc + no)
+                try:
+                    shuffled = np.frombuffer(zlib.decompress(stored[:nc]), dtype=np.uint8)
+                    codes = np.frombuffer(zlib.decompress(stored[nc:]), dtype=np.uint8)
+                except zlib.error:
+                    shuffled = codes = np.zeros(0, dtype=np.uint8)
+                if shuffled.size != points * width or codes.size != points:
+                    self.fail(f"tile {tile} is recorded done in /progress/tile_done, but its stored chunks (at byte {at}) "
+                              "do not decompress to one tile: the file is damaged")
+                chunk = np.ascontiguousarray(shuffled.reshape(width, points).T).view(f"<u{width}").reshape(self.tile_shape)
+                here = [np.flatnonzero(p // t == c) for p, t, c in zip(positions, self.tile_shape, coords)]
+                local = [p[h] - c * t for p, h, t, c in zip(positions, here, self.tile_shape, coords)]
+                counts[np.ix_(*here)] = chunk[np.ix_(*local)]
+                outcomes[np.ix_(*here)] = codes.reshape(self.tile_shape)[np.ix_(*local)]
+        return counts, outcomes
+
     def _verify_tiles(self, positions):
         """Checks each done tile the block meets, once, against /progress/tile_checksum."""
         tiles = [np.unique(p // t) for p, t in zip(positions, self.tile_shape)]
@@ -788,7 +878,10 @@ class Result:
             if self._done[tile] == 0 or self._verified[tile]:
                 continue
             origin = tuple(int(c) * t for c, t in zip(coords, self.tile_shape))
-            checksum = tile_checksum(self.counts, self.outcomes, tile, origin)
+            if self._compressed:
+                checksum = stored_tile_checksum(self.path, tile, *(int(v) for v in self._stored[tile]))
+            else:
+                checksum = tile_checksum(self.counts, self.outcomes, tile, origin)
             if checksum is None:
                 if not self._checksums_unchecked:
                     warn(f"python3-xxhash is not installed: the tiles of {self.path} are not checked against their "
@@ -867,6 +960,22 @@ def tile_checksum(counts, outcomes, tile, origin):
     except H5PY_ERRORS:
         return -1  # a chunk that cannot be read matches no checksum
     return xxhash.xxh3_64_intdigest(stored_outcomes, seed=xxhash.xxh3_64_intdigest(stored_counts, seed=tile))
+
+
+def stored_tile_checksum(path, tile, at, counts_bytes, outcomes_bytes):
+    """The checksum a compressed partial file records for a tile: as tile_checksum, of its
+    stored (compressed) chunks at byte `at`.  None when python3-xxhash is not installed."""
+    try:
+        import xxhash  # Debian's python3-xxhash
+    except ImportError:
+        return None
+    with open(path, "rb") as f:
+        f.seek(at)
+        stored = f.read(counts_bytes + outcomes_bytes)
+    if len(stored) != counts_bytes + outcomes_bytes:
+        return -1
+    return xxhash.xxh3_64_intdigest(stored[counts_bytes:],
+                                    seed=xxhash.xxh3_64_intdigest(stored[:counts_bytes], seed=tile))
 
 
 def warn_if_incomplete(result):

@@ -109,27 +109,110 @@ def tile_checksum(dataset_counts, dataset_outcomes, tile, origin):
     return xxhash.xxh3_64_intdigest(outcomes, seed=xxhash.xxh3_64_intdigest(counts, seed=tile))
 
 
+def stored_chunk(values):
+    """A chunk as HDF5's shuffle and deflate filters store it, written independently of
+    superball (numpy and zlib): the little-endian bytes of the values grouped by
+    significance, then a zlib stream."""
+    import zlib
+    import numpy as np
+    data = np.ascontiguousarray(values)
+    width = data.dtype.itemsize
+    raw = data.astype(data.dtype.newbyteorder("<")).view(np.uint8).reshape(-1, width)
+    return zlib.compress(np.ascontiguousarray(raw.T).tobytes(), 6)
+
+
+def read_partial(path):
+    """(counts, outcomes, done flags) of a partial file, read independently of superball:
+    an uncompressed file's chunks through h5py, a compressed file's tiles from the bytes
+    /progress/tile_stored points at (zlib, then the shuffle undone with numpy). The points
+    of tiles not done are zero."""
+    import zlib
+    import h5py
+    import numpy as np
+    with h5py.File(path, "r") as f:
+        counts_set, outcomes_set = f["wall_bounces"], f["outcome"]
+        done = f["progress/tile_done"][()]
+        tile_shape = [int(n) for n in f.attrs["tile_shape"]]
+        if counts_set.compression is None:
+            counts, outcomes = counts_set[()], outcomes_set[()]
+        else:
+            stored = f["progress/tile_stored"][()]
+            counts = np.zeros(counts_set.shape, counts_set.dtype)
+            outcomes = np.zeros(outcomes_set.shape, np.uint8)
+            width, points = counts_set.dtype.itemsize, int(np.prod(tile_shape))
+            with open(path, "rb") as raw:
+                for t, box in enumerate(tile_boxes(counts.shape, tile_shape)):
+                    if not done[t]:
+                        continue
+                    at, nc, no = (int(v) for v in stored[t])
+                    raw.seek(at)
+                    data = raw.read(nc + no)
+                    planes = np.frombuffer(zlib.decompress(data[:nc]), np.uint8).reshape(width, points)
+                    chunk = np.ascontiguousarray(planes.T).view(f"<u{width}").reshape(tile_shape)
+                    codes = np.frombuffer(zlib.decompress(data[nc:]), np.uint8).reshape(tile_shape)
+                    part = tuple(slice(0, b.stop - b.start) for b in box)
+                    counts[box], outcomes[box] = chunk[part], codes[part]
+        for t, box in enumerate(tile_boxes(counts.shape, tile_shape)):
+            if not done[t]:
+                counts[box], outcomes[box] = 0, 0
+    return counts, outcomes, done
+
+
 def interrupted_run(binary, job, out, reference, done):
     """The partial file (OUT.partial) of an interrupted run of `job`: a run stopped before its
     first tile (--stop-after 0), then the tiles t with done(t) filled with `reference`'s
-    values and recorded done with their checksums, as the run would have. Returns its path."""
+    values and recorded done with their checksums, as the run would have: uncompressed
+    (the job's compression = 0), written to their chunks; compressed, appended past the
+    file's end with /progress/tile_stored saying where. Returns its path."""
     import h5py
+    import numpy as np
+    import xxhash  # Debian's python3-xxhash
     r = subprocess.run([binary, "explore", job, "-o", out, "-q", "--stop-after", "0"], capture_output=True, text=True,
                        env=mpi_env(), timeout=300)
     assert r.returncode == 1, r.stderr
     partial = out + ".partial"
+    appended = []
     with h5py.File(reference, "r") as ref, h5py.File(partial, "r+") as f:
         counts, outcomes = f["wall_bounces"], f["outcome"]
+        compressed = counts.compression is not None
         flags, sums = f["progress/tile_done"][()], f["progress/tile_checksum"][()]
-        for t, box in enumerate(tile_boxes(counts.shape, [int(n) for n in f.attrs["tile_shape"]])):
+        tile_shape = [int(n) for n in f.attrs["tile_shape"]]
+        if compressed:
+            stored, end = f["progress/tile_stored"][()], os.path.getsize(partial)
+        for t, box in enumerate(tile_boxes(counts.shape, tile_shape)):
             if not done(t):
                 continue
-            counts[box] = ref["wall_bounces"][box]
-            outcomes[box] = ref["outcome"][box]
-            sums[t] = tile_checksum(counts, outcomes, t, tuple(s.start for s in box))
+            if compressed:
+                # The tile's values in its chunk's layout: full tile shape, zeros past the grid.
+                c = np.zeros(tile_shape, dtype=counts.dtype)
+                o = np.zeros(tile_shape, dtype=np.uint8)
+                part = tuple(slice(0, s.stop - s.start) for s in box)
+                c[part], o[part] = ref["wall_bounces"][box], ref["outcome"][box]
+                sc, so = stored_chunk(c), stored_chunk(o)
+                stored[t] = (end, len(sc), len(so))
+                sums[t] = xxhash.xxh3_64_intdigest(so, seed=xxhash.xxh3_64_intdigest(sc, seed=t))
+                appended.append(sc + so)
+                end += len(sc) + len(so)
+            else:
+                counts[box] = ref["wall_bounces"][box]
+                outcomes[box] = ref["outcome"][box]
+                sums[t] = tile_checksum(counts, outcomes, t, tuple(s.start for s in box))
             flags[t] = 1
+        if compressed:
+            f["progress/tile_stored"][...] = stored
         f["progress/tile_checksum"][...] = sums
         f["progress/tile_done"][...] = flags
+    # After h5py has closed the file (it cuts a file opened for writing to its own end).
+    with open(partial, "ab") as f:
+        for chunk in appended:
+            f.write(chunk)
+    if compressed:
+        # The run resumed and stopped at once, as a stopped run ends: its checks pass over
+        # the tiles written here, and the file's HDF5 end is moved past them (as a run's
+        # checkpoints do), so that h5py may open it for writing without cutting them off.
+        r = subprocess.run([binary, "explore", job, "-o", out, "-q", "--resume", "--stop-after", "0"],
+                           capture_output=True, text=True, env=mpi_env(), timeout=300)
+        assert r.returncode == 1, r.stderr
     return partial
 
 

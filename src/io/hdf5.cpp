@@ -178,6 +178,13 @@ Storage dataset_storage(hid_t dataset)
         const int rank = check(H5Pget_chunk(dcpl, static_cast<int>(st.chunk.size()), st.chunk.data()), "H5Pget_chunk");
         if (static_cast<std::size_t>(rank) != s.dims.size()) throw Error("HDF5: the chunks' rank differs from the dataset's");
         st.filters = check(H5Pget_nfilters(dcpl), "H5Pget_nfilters");
+        for (int i = 0; i < st.filters; ++i) {
+            unsigned flags = 0, values[4] = {};
+            std::size_t n = 4;
+            const H5Z_filter_t f = H5Pget_filter2(dcpl, static_cast<unsigned>(i), &flags, &n, values, 0, nullptr, nullptr);
+            if (f == H5Z_FILTER_SHUFFLE) st.shuffle = true;
+            if (f == H5Z_FILTER_DEFLATE) st.deflate_level = n > 0 ? static_cast<int>(values[0]) : 0;
+        }
         // Chunks expected: the grid of chunks over the extent.
         hsize_t expected = 1;
         for (std::size_t k = 0; k < s.dims.size(); ++k) {

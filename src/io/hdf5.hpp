@@ -137,6 +137,8 @@ std::vector<hsize_t> dataset_shape(hid_t dataset);
 struct Storage {
     std::vector<hsize_t> chunk;
     int filters = 0;
+    int deflate_level = -1;  // the deflate filter's level; -1 without one
+    bool shuffle = false;    // the shuffle filter is in the pipeline
     bool allocated = false;
 };
 Storage dataset_storage(hid_t dataset);

@@ -1,18 +1,19 @@
 // The layout of superball's files, in one place for the writers and the reader.
 //
-// Two kinds of file, both plain HDF5:
+// Two kinds of file, both plain HDF5, one the other's later state:
 //
-//  - a *result* (`OUTPUT`, e.g. results/slice.h5), written once a run is complete, laid out
-//    for readers: netCDF-4/CF conventions (a coordinate variable per axis at the root,
+//  - a *partial* file (`OUTPUT.partial`), where a run in progress keeps its tiles
+//    (io/partial_file.hpp): the result's objects, one chunk per tile, and the resume
+//    journal /progress (tile_done, tile_checksum, and for compressed tiles tile_stored,
+//    where each lies). Compressed tiles are written past the end of the HDF5 objects and
+//    not yet in the chunk index; uncompressed ones straight to their preallocated chunks;
+//  - a *result* (`OUTPUT`, e.g. results/slice.h5): the partial file once every tile is
+//    done, its chunks indexed where they lie, the journal removed, renamed. Laid out for
+//    readers: netCDF-4/CF conventions (a coordinate variable per axis at the root,
 //    attached as a dimension scale to /wall_bounces and /outcome, long_name and units on
-//    every variable, flag_values/flag_meanings on /outcome), compressed (shuffle +
-//    deflate) in chunks of about 256 Ki points, and an XDMF sidecar for ParaView;
-//  - a *partial* file (`OUTPUT.partial`), where a run in progress keeps its tiles, laid out
-//    for parallel writers: one chunk per tile, uncompressed, every chunk allocated
-//    contiguously and aligned at creation (ranks write runs of consecutive tiles straight
-//    to their offsets), and the resume journal /progress/tile_done and tile_checksum.
-//    The run renames nothing: once every tile is done it writes the result from the
-//    partial file and removes it, so an incomplete run never sits under the result's name.
+//    every variable, flag_values/flag_meanings on /outcome), compressed (shuffle + deflate)
+//    in chunks of up to 256 Ki points (the tiles), and an XDMF sidecar for ParaView.
+//    An incomplete run never sits under the result's name.
 //
 // Both carry the same root attributes (the job, the model, the software) and coordinate
 // variables; `superball_file` says which kind a file is.
@@ -27,7 +28,10 @@
 namespace superball::layout {
 
 // Format generation: a reader refuses other values; files of superball 0.1 had none.
-inline constexpr std::int64_t format_version = 2;
+// 3: partial files hold compressed tiles past their HDF5 objects (tile_stored); results
+// are laid out as in format 2, which is still read.
+inline constexpr std::int64_t format_version = 3;
+inline constexpr std::int64_t oldest_result_format = 2;
 
 inline constexpr const char* kind_attribute = "superball_file";
 inline constexpr const char* kind_result = "result";
@@ -37,6 +41,7 @@ inline constexpr const char* wall_bounces = "/wall_bounces";
 inline constexpr const char* outcome = "/outcome";
 inline constexpr const char* tile_done = "/progress/tile_done";
 inline constexpr const char* tile_checksum = "/progress/tile_checksum";
+inline constexpr const char* tile_stored = "/progress/tile_stored";
 
 // outcome codes, SPEC.md section 3, as CF flags.
 inline constexpr std::array<std::uint8_t, 4> outcome_codes = {0, 1, 2, 3};
@@ -44,8 +49,6 @@ inline constexpr const char* outcome_meanings = "invalid left missed capped";
 
 // Where a run in progress keeps its tiles: OUTPUT.partial.
 std::filesystem::path partial_path(const std::filesystem::path& output);
-// Where the result is written before it takes its name: OUTPUT.finishing.
-std::filesystem::path finishing_path(const std::filesystem::path& output);
 // The XDMF sidecar of a result: OUTPUT with the extension .xmf.
 std::filesystem::path sidecar_path(const std::filesystem::path& output);
 

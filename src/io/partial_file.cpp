@@ -1,45 +1,56 @@
 #include "partial_file.hpp"
 
 #include <fmt/core.h>
-#include <xxhash.h>
 
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <stdexcept>
 #include <type_traits>
 
 #include "hdf5.hpp"
 #include "layout.hpp"
+#include "placed_chunks.hpp"
 #include "result_metadata.hpp"
 
 namespace superball {
 
 static_assert(std::endian::native == std::endian::little,
-              "the partial file's chunks are written as bytes in memory order: little-endian hosts only");
+              "the partial file's journal and uncompressed chunks are written as bytes in memory order: little-endian hosts "
+              "only");
 
 namespace {
 
 std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
 
-// A dataset whose chunks are the tiles, all allocated at creation and never filled. With
-// the HDF5 1.10 format, no filter and early allocation, HDF5 indexes the chunks
-// implicitly: chunk t lies at the dataset's first chunk plus t chunks (partial_layout
-// checks it), with no index to update, so ranks write chunks straight to their offsets.
-void create_tiled(hid_t file, const char* name, hid_t type, const Tiling& tiling)
+// The data of a dataset, one chunk per tile. Uncompressed: every chunk allocated at
+// creation and never filled; with the HDF5 1.10 format, no filter and early allocation,
+// HDF5 indexes the chunks implicitly (chunk t lies at the dataset's first chunk plus t
+// chunks: layout_of checks it), with no index to update, so ranks write chunks straight to
+// their offsets. Compressed: the result's filter pipeline (shuffle, then deflate at
+// `level`: every HDF5 reads it without plugins), no chunk allocated; the chunks are
+// indexed where rank 0 appended them when the run completes.
+void create_tiled(hid_t file, const char* name, hid_t type, const Tiling& tiling, int level)
 {
     const h5::Id space = h5::simple_space(to_hsize(tiling.shape()));
     const auto chunk = to_hsize(tiling.tile_shape());
     const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
     h5::check(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), "H5Pset_chunk");
-    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    if (level > 0) {
+        h5::check(H5Pset_shuffle(dcpl), "H5Pset_shuffle");
+        h5::check(H5Pset_deflate(dcpl, static_cast<unsigned>(level)), "H5Pset_deflate");
+        h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_INCR), "H5Pset_alloc_time");
+    } else {
+        h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
+    }
     h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER), "H5Pset_fill_time");
     h5::dataset_id(H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
 }
 
-// A contiguous 1-D dataset of one entry per tile, zeros (no tile done yet).
-void create_journal(hid_t loc, const char* name, hid_t type, hsize_t n)
+// A contiguous dataset of one row per tile, zeros (no tile done yet).
+void create_journal(hid_t loc, const char* name, hid_t type, hsize_t n, hsize_t per_tile = 1)
 {
-    const h5::Id space = h5::simple_space({n});
+    const h5::Id space = h5::simple_space(per_tile == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, per_tile});
     const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
     h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
     h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC), "H5Pset_fill_time");
@@ -53,11 +64,22 @@ PartialLayout layout_of(hid_t file, const Tiling& tiling)
 {
     PartialLayout l;
     l.tiles = tiling.tiles();
-    l.chunk_points = 1;
-    for (const std::uint64_t s : tiling.tile_shape()) l.chunk_points *= s;
+    l.chunk_points = tiling.tile_points();
     const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
     const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
     l.count_bytes = h5::dataset_shape_of(counts).bytes;
+    const h5::Storage st = h5::dataset_storage(counts);
+    l.compressed = st.filters > 0;
+    l.done_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_done));
+    l.checksums_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_checksum));
+    if (l.compressed) {
+        if (st.deflate_level < 1 || st.deflate_level > 9 || !st.shuffle) {
+            throw h5::Error("the partial file's /wall_bounces is compressed otherwise than with shuffle and deflate 1-9");
+        }
+        l.level = static_cast<std::uint64_t>(st.deflate_level);
+        l.stored_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_stored));
+        return l;
+    }
     const auto contiguous_chunks = [&](hid_t d, std::uint64_t chunk_bytes) {
         const std::uint64_t first = h5::chunk_offset(d, chunk_origin(tiling, 0));
         const std::uint64_t last = h5::chunk_offset(d, chunk_origin(tiling, l.tiles - 1));
@@ -70,14 +92,12 @@ PartialLayout layout_of(hid_t file, const Tiling& tiling)
     };
     l.counts_at = contiguous_chunks(counts, l.counts_chunk());
     l.outcomes_at = contiguous_chunks(outcomes, l.outcomes_chunk());
-    l.done_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_done));
-    l.checksums_at = h5::contiguous_offset(h5::open_dataset(file, layout::tile_checksum));
     return l;
 }
 
 // Places a tile's values, row-major over its box, into its chunk (row-major over the tile
-// shape; an edge tile's box is smaller and the rest of the chunk stays zero), converting
-// each value with `put`.
+// shape; an edge tile's box is smaller and the rest of the chunk stays as it is),
+// converting each value with `put` (a narrowing copy, fused with the placement).
 template <class Put>
 void place(const Extent& box_count, const Extent& tile_shape, std::size_t n, Put&& put)
 {
@@ -104,13 +124,6 @@ void place(const Extent& box_count, const Extent& tile_shape, std::size_t n, Put
 
 }  // namespace
 
-std::uint64_t tile_checksum(std::uint64_t tile, std::span<const std::byte> counts_chunk,
-                            std::span<const std::byte> outcomes_chunk)
-{
-    const XXH64_hash_t first = XXH3_64bits_withSeed(counts_chunk.data(), counts_chunk.size(), tile);
-    return XXH3_64bits_withSeed(outcomes_chunk.data(), outcomes_chunk.size(), first);
-}
-
 PartialLayout create_partial(const std::filesystem::path& path, const Job& job, const Grid& grid, const Tiling& tiling,
                              int ranks)
 {
@@ -121,9 +134,10 @@ PartialLayout create_partial(const std::filesystem::path& path, const Job& job, 
         const h5::Id progress = h5::create_group(file, "/progress");
         create_journal(file, layout::tile_done, H5T_STD_U8LE, tiling.tiles());
         create_journal(file, layout::tile_checksum, H5T_STD_U64LE, tiling.tiles());
+        if (job.compression > 0) create_journal(file, layout::tile_stored, H5T_STD_U64LE, tiling.tiles(), 3);
     }
-    create_tiled(file, layout::wall_bounces, count_type(job), tiling);
-    create_tiled(file, layout::outcome, H5T_STD_U8LE, tiling);
+    create_tiled(file, layout::wall_bounces, count_type(job), tiling, job.compression);
+    create_tiled(file, layout::outcome, H5T_STD_U8LE, tiling, job.compression);
     const std::vector<h5::Id> axes = write_metadata(file, job, grid, layout::kind_partial, {ranks, 0.0, false}, true);
     {
         const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
@@ -143,9 +157,11 @@ PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& ti
 
 double record_partial_run(const std::filesystem::path& path, double seconds, int ranks)
 {
-    const h5::Id file = h5::open_file(path, true);
-    const double total = h5::read_double_attribute(file, "wall_seconds") + seconds;
-    write_run_figures(file, {ranks, total, false});
+    PlacedChunks file(path);
+    const double total = h5::read_double_attribute(file.file(), "wall_seconds") + seconds;
+    write_run_figures(file.file(), {ranks, total, false});
+    file.close();
+    PlacedChunks::discard_undo(path);
     return total;
 }
 
@@ -156,29 +172,47 @@ PartialFile::PartialFile(const std::filesystem::path& path, const mpi::Comm& com
 {
 }
 
-std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums)
+std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
+                                                std::span<const StoredChunk> stored)
 {
     // Contiguous shares: runs of consecutive tiles are read in one piece.
     const auto ranks = static_cast<std::uint64_t>(comm_.size());
     const auto rank = static_cast<std::uint64_t>(comm_.rank());
     const std::uint64_t begin = done.size() * rank / ranks, end = done.size() * (rank + 1) / ranks;
-    const std::uint64_t cb = layout_.counts_chunk(), ob = layout_.outcomes_chunk();
-    constexpr std::uint64_t max_run = std::uint64_t{8} << 20;
-    const std::uint64_t run_tiles = std::max<std::uint64_t>(1, max_run / cb);
-    std::vector<std::byte> counts, outcomes;
     std::vector<std::uint64_t> bad;
-    for (std::uint64_t i = begin; i < end;) {
-        std::uint64_t n = 1;
-        while (i + n < end && n < run_tiles && done[i + n] == done[i] + n) ++n;
-        counts.resize(n * cb);
-        outcomes.resize(n * ob);
-        file_.read_at(layout_.counts_at + done[i] * cb, counts.data(), counts.size());
-        file_.read_at(layout_.outcomes_at + done[i] * ob, outcomes.data(), outcomes.size());
-        for (std::uint64_t j = 0; j < n; ++j) {
-            const std::span<const std::byte> c(counts.data() + j * cb, cb), o(outcomes.data() + j * ob, ob);
-            if (tile_checksum(done[i + j], c, o) != checksums[i + j]) bad.push_back(done[i + j]);
+    std::vector<std::byte> counts, outcomes;
+    if (layout_.compressed) {
+        const std::uint64_t size = file_.size();
+        for (std::uint64_t i = begin; i < end; ++i) {
+            const StoredChunk& s = stored[i];
+            if (s.end() > size || s.end() < s.address) {
+                bad.push_back(done[i]);
+                continue;
+            }
+            counts.resize(s.counts_bytes + s.outcomes_bytes);
+            file_.read_at(s.address, counts.data(), counts.size());
+            const std::span<const std::byte> all(counts);
+            if (tile_checksum(done[i], all.first(s.counts_bytes), all.subspan(s.counts_bytes)) != checksums[i]) {
+                bad.push_back(done[i]);
+            }
         }
-        i += n;
+    } else {
+        const std::uint64_t cb = layout_.counts_chunk(), ob = layout_.outcomes_chunk();
+        constexpr std::uint64_t max_run = std::uint64_t{8} << 20;
+        const std::uint64_t run_tiles = std::max<std::uint64_t>(1, max_run / cb);
+        for (std::uint64_t i = begin; i < end;) {
+            std::uint64_t n = 1;
+            while (i + n < end && n < run_tiles && done[i + n] == done[i] + n) ++n;
+            counts.resize(n * cb);
+            outcomes.resize(n * ob);
+            file_.read_at(layout_.counts_at + done[i] * cb, counts.data(), counts.size());
+            file_.read_at(layout_.outcomes_at + done[i] * ob, outcomes.data(), outcomes.size());
+            for (std::uint64_t j = 0; j < n; ++j) {
+                const std::span<const std::byte> c(counts.data() + j * cb, cb), o(outcomes.data() + j * ob, ob);
+                if (tile_checksum(done[i + j], c, o) != checksums[i + j]) bad.push_back(done[i + j]);
+            }
+            i += n;
+        }
     }
     // Every rank's findings, in tile order (the shares are in order).
     std::vector<double> mine(bad.begin(), bad.end());
@@ -186,6 +220,116 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
     std::vector<std::uint64_t> out(all.begin(), all.end());
     comm_.broadcast(out);
     return out;
+}
+
+// ---------------------------------------------------------------------------- TileBatch
+
+std::vector<TileReport> TileBatch::reports() const
+{
+    std::vector<TileReport> r(tiles());
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] = {entries[words * i], entries[words * i + 1]};
+    return r;
+}
+
+std::vector<std::byte> TileBatch::pack() const
+{
+    const std::uint64_t n = tiles();
+    std::vector<std::byte> out(8 * (1 + entries.size()) + data.size());
+    std::memcpy(out.data(), &n, 8);
+    std::memcpy(out.data() + 8, entries.data(), 8 * entries.size());
+    std::memcpy(out.data() + 8 * (1 + entries.size()), data.data(), data.size());
+    return out;
+}
+
+TileBatch TileBatch::unpack(std::span<const std::byte> message)
+{
+    TileBatch b;
+    std::uint64_t n = 0;
+    if (message.size() < 8) throw std::runtime_error("a batch of tiles shorter than its header");
+    std::memcpy(&n, message.data(), 8);
+    if (n > (message.size() - 8) / (8 * words)) throw std::runtime_error("a batch of tiles shorter than its entries");
+    b.entries.resize(n * words);
+    std::memcpy(b.entries.data(), message.data() + 8, 8 * b.entries.size());
+    std::uint64_t bytes = 0;
+    for (std::uint64_t i = 0; i < n; ++i) bytes += b.entries[words * i + 2] + b.entries[words * i + 3];
+    const std::size_t at = 8 * (1 + b.entries.size());
+    if (message.size() - at != bytes) throw std::runtime_error("a batch of tiles whose data do not match its entries");
+    b.data.assign(message.begin() + static_cast<std::ptrdiff_t>(at), message.end());
+    return b;
+}
+
+// ------------------------------------------------------------------------ ChunkAppender
+
+ChunkAppender::ChunkAppender(PartialFile& file, std::uint64_t start, std::uint64_t buffer_bytes)
+    : file_(file), capacity_(buffer_bytes), end_(start)
+{
+}
+
+void ChunkAppender::add(const TileBatch& batch)
+{
+    Buffer* b = &buffers_[current_];
+    if (!b->bytes.empty() && b->bytes.size() + batch.data.size() > capacity_) {
+        issue();
+        b = &buffers_[current_];
+    }
+    if (b->bytes.empty()) b->at = end_;
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < batch.tiles(); ++i) {
+        const std::uint64_t* e = batch.entries.data() + TileBatch::words * i;
+        b->tiles.push_back({e[0], e[1], {end_ + at, e[2], e[3]}});
+        at += e[2] + e[3];
+    }
+    b->bytes.insert(b->bytes.end(), batch.data.begin(), batch.data.end());
+    end_ += batch.data.size();
+    // Written at once when no write is in progress (the journal lags the counting by
+    // little), else gathered until the write in progress is done or the buffer is full.
+    const Buffer& other = buffers_[1 - current_];
+    if (b->bytes.size() >= capacity_ || !other.write.valid() ||
+        other.write.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+        issue();
+    }
+}
+
+void ChunkAppender::issue()
+{
+    Buffer& b = buffers_[current_];
+    if (b.bytes.empty()) return;
+    const PosixFile& f = file_.file();
+    // A thread per write (a few per second at most): the buffer stays untouched until waited for.
+    b.write = std::async(std::launch::async, [&f, &b] { f.write_at(b.at, b.bytes.data(), b.bytes.size()); });
+    current_ = 1 - current_;
+    complete(buffers_[current_]);
+}
+
+void ChunkAppender::complete(Buffer& b)
+{
+    if (!b.write.valid()) return;
+    try {
+        b.write.get();
+    } catch (const std::exception& e) {
+        throw h5::Error(fmt::format("writing {} compressed tiles at byte {} of {} failed ({}){}; the tiles recorded done are "
+                                    "kept: run the same command with --resume once the cause is fixed",
+                                    b.tiles.size(), b.at, file_.path().string(), e.what(), free_space_note(file_.path())));
+    }
+    written_.insert(written_.end(), b.tiles.begin(), b.tiles.end());
+    b.tiles.clear();
+    b.bytes.clear();
+}
+
+std::vector<AppendedTile> ChunkAppender::written()
+{
+    Buffer& other = buffers_[1 - current_];
+    if (other.write.valid() && other.write.wait_for(std::chrono::seconds(0)) == std::future_status::ready) complete(other);
+    return std::exchange(written_, {});
+}
+
+std::vector<AppendedTile> ChunkAppender::flush()
+{
+    // At most one buffer is being written, the other one; issue() waits for it before the
+    // current buffer's write is waited for, so tiles keep their order.
+    issue();
+    complete(buffers_[1 - current_]);
+    return std::exchange(written_, {});
 }
 
 // --------------------------------------------------------------------------- TileWriter
@@ -230,7 +374,6 @@ void TileWriter::add(std::uint64_t tile, std::span<const std::uint32_t> counts, 
     }
     place(box.count, shape, outcomes.size(), [&](std::size_t dst, std::size_t src) { o[dst] = outcomes[src]; });
     b->reports.push_back({tile, tile_checksum(tile, counts_bytes, std::as_bytes(std::span(o, n)))});
-    if (retained_) retained_->add(tile, counts_bytes, std::as_bytes(std::span(o, n)));
     ++b->count;
 }
 
@@ -281,28 +424,40 @@ std::vector<TileReport> TileWriter::flush()
 
 // ------------------------------------------------------------------------------ Journal
 
-Journal::Journal(PartialFile& file, std::vector<std::uint8_t> done, std::vector<std::uint64_t> checksums,
-                 std::chrono::duration<double> interval)
+Journal::Journal(PartialFile& file, TileJournal journal, std::chrono::duration<double> interval)
     : file_(file),
-      done_(std::move(done)),
-      checksums_(std::move(checksums)),
+      journal_(std::move(journal)),
       interval_(interval),
       last_(std::chrono::steady_clock::now()),
-      dirty_begin_(done_.size())
+      dirty_begin_(journal_.done.size())
 {
-    tiles_done_ = static_cast<std::uint64_t>(std::count(done_.begin(), done_.end(), std::uint8_t{1}));
+    tiles_done_ = static_cast<std::uint64_t>(std::count(journal_.done.begin(), journal_.done.end(), std::uint8_t{1}));
+    if (file_.layout().compressed) journal_.stored.resize(journal_.done.size());
+}
+
+void Journal::mark(std::uint64_t tile, std::uint64_t checksum)
+{
+    if (journal_.done[tile] == 0) ++tiles_done_;
+    journal_.done[tile] = 1;
+    journal_.checksums[tile] = checksum;
+    dirty_begin_ = std::min(dirty_begin_, tile);
+    dirty_end_ = std::max(dirty_end_, tile + 1);
 }
 
 void Journal::record(std::span<const TileReport> tiles)
 {
-    for (const TileReport& r : tiles) {
-        if (done_[r.tile] == 0) ++tiles_done_;
-        done_[r.tile] = 1;
-        checksums_[r.tile] = r.checksum;
-        dirty_begin_ = std::min(dirty_begin_, r.tile);
-        dirty_end_ = std::max(dirty_end_, r.tile + 1);
+    for (const TileReport& r : tiles) mark(r.tile, r.checksum);
+}
+
+void Journal::record(std::span<const AppendedTile> tiles)
+{
+    for (const AppendedTile& a : tiles) {
+        journal_.stored[a.tile] = a.stored;
+        mark(a.tile, a.checksum);
     }
 }
+
+bool Journal::due() const { return dirty_end_ > dirty_begin_ && std::chrono::steady_clock::now() - last_ >= interval_; }
 
 void Journal::checkpoint(bool now)
 {
@@ -311,15 +466,19 @@ void Journal::checkpoint(bool now)
     const PartialLayout& l = file_.layout();
     const std::uint64_t n = dirty_end_ - dirty_begin_;
     try {
-        // Checksums before the flags that vouch for them.
-        file_.file().write_at(l.checksums_at + 8 * dirty_begin_, checksums_.data() + dirty_begin_, 8 * n);
-        file_.file().write_at(l.done_at + dirty_begin_, done_.data() + dirty_begin_, n);
+        // Where the tiles lie and their checksums, before the flags that vouch for them.
+        if (l.compressed) {
+            static_assert(sizeof(StoredChunk) == 24 && std::is_standard_layout_v<StoredChunk>);
+            file_.file().write_at(l.stored_at + 24 * dirty_begin_, journal_.stored.data() + dirty_begin_, 24 * n);
+        }
+        file_.file().write_at(l.checksums_at + 8 * dirty_begin_, journal_.checksums.data() + dirty_begin_, 8 * n);
+        file_.file().write_at(l.done_at + dirty_begin_, journal_.done.data() + dirty_begin_, n);
     } catch (const std::exception& e) {
         throw h5::Error(fmt::format("recording tiles {} to {} done in {} failed ({}){}", dirty_begin_, dirty_end_ - 1,
                                     file_.path().string(), e.what(), free_space_note(file_.path())));
     }
     last_ = t;
-    dirty_begin_ = done_.size();
+    dirty_begin_ = journal_.done.size();
     dirty_end_ = 0;
 }
 

@@ -1,18 +1,29 @@
-// The partial file of a run in progress (io/layout.hpp): created by rank 0 with serial
-// HDF5, every chunk (one per tile) allocated contiguously and aligned, nothing filled;
-// during the run every rank writes its tiles through MPI-IO straight to their offsets, so
-// the HDF5 metadata never change and the file is consistent at every moment.
+// The partial file of a run in progress (io/layout.hpp), which becomes the result when
+// the run completes. Created by rank 0 with serial HDF5: every object of the result
+// (coordinates, attributes, /wall_bounces and /outcome chunked one chunk per tile) and
+// the resume journal (/progress). During the run the HDF5 metadata never change, so the
+// file is consistent at every moment; tiles reach it in one of two ways:
 //
-// Crash safety: a tile is recorded done in the journal (/progress/tile_done, written by
-// rank 0 only) after its data and checksum are written, so a process killed at any
-// moment leaves a file in which every tile marked done holds its data. A resume checks the
-// done tiles against their checksums (PartialFile::damaged) and refuses a damaged file.
+//  - compressed (the default): each rank compresses a tile when it has counted it
+//    (io/chunk_codec.hpp) and sends the bytes to rank 0, whose ChunkAppender writes them
+//    one after the other past the end of the HDF5 objects; the journal records where. At
+//    the end rank 0 indexes them where they lie (io/placed_chunks.hpp, final_result.hpp):
+//    nothing is read back or written twice. Compressed tiles are 0.2-30 % of the raw
+//    data, so one writer carries many ranks;
+//  - uncompressed (`[run] compression = 0`): every chunk is allocated at creation,
+//    contiguous and aligned (HDF5's implicit chunk index), and each rank writes its tiles
+//    straight to their offsets (TileWriter).
+//
+// Crash safety: a tile is recorded done in the journal (written by rank 0 only) after its
+// bytes and checksum are written, so a process killed at any moment leaves a file in which
+// every tile marked done holds its data. A resume checks the done tiles against their
+// checksums (PartialFile::damaged) and refuses a damaged file.
 #pragma once
 
 #include <chrono>
-#include <future>
 #include <cstdint>
 #include <filesystem>
+#include <future>
 #include <span>
 #include <vector>
 
@@ -22,16 +33,20 @@
 #include "mpi/mpi.hpp"
 #include "page_buffer.hpp"
 #include "posix_file.hpp"
-#include "retained_tiles.hpp"
+#include "stored_tiles.hpp"
 
 namespace superball {
 
-// Where the data of a partial file lie: byte offsets and sizes, the same on every rank.
+// Where the data and the journal of a partial file lie: byte offsets and sizes, the same
+// on every rank.
 struct PartialLayout {
-    std::uint64_t counts_at = 0;     // chunk 0 of /wall_bounces (chunk t follows at t * counts_chunk)
-    std::uint64_t outcomes_at = 0;   // chunk 0 of /outcome
+    bool compressed = false;         // tiles appended compressed, else at fixed offsets
+    std::uint64_t level = 0;         // the deflate level of a compressed file
+    std::uint64_t counts_at = 0;     // uncompressed: chunk 0 of /wall_bounces (chunk t at t * counts_chunk)
+    std::uint64_t outcomes_at = 0;   // uncompressed: chunk 0 of /outcome
     std::uint64_t done_at = 0;       // /progress/tile_done[0] (one byte per tile)
     std::uint64_t checksums_at = 0;  // /progress/tile_checksum[0] (8 bytes per tile, little-endian)
+    std::uint64_t stored_at = 0;     // compressed: /progress/tile_stored[0] (3 x 8 bytes per tile)
     std::uint64_t count_bytes = 2;   // bytes of one count: 2 (uint16) or 4 (uint32)
     std::uint64_t chunk_points = 0;  // points of a chunk (a full tile)
     std::uint64_t tiles = 0;
@@ -40,21 +55,18 @@ struct PartialLayout {
     std::uint64_t outcomes_chunk() const { return chunk_points; }
 };
 
-// The checksum of a tile as the partial file stores it: XXH3-64 (xxHash, a stable format)
-// of the tile's chunk of /wall_bounces then its chunk of /outcome, as stored (little-endian,
-// a chunk's points beyond the grid's edge zero), seeded with the tile's number.
-std::uint64_t tile_checksum(std::uint64_t tile, std::span<const std::byte> counts_chunk,
-                            std::span<const std::byte> outcomes_chunk);
-
 // Rank 0 only: creates the partial file of `job` at `path` (replacing any file there) for
-// `ranks` ranks, and returns its layout. The coordinate variables and attributes are those
-// of a result; the run's figures (wall_seconds, mpi_ranks) start at zero.
+// `ranks` ranks, compressed at the job's level unless it is 0, and returns its layout.
+// The coordinate variables and attributes are those of a result; the run's figures
+// (wall_seconds, mpi_ranks) start at zero.
 PartialLayout create_partial(const std::filesystem::path& path, const Job& job, const Grid& grid, const Tiling& tiling,
                              int ranks);
-// Rank 0 only: the layout of an existing partial file (validated by ResultReader before).
+// Rank 0 only: the layout of an existing partial file (validated by ResultReader before):
+// compressed or not as it was created, whatever the job says now.
 PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& tiling);
 // Rank 0 only, with no rank holding the file open: adds a run's seconds to wall_seconds and
-// records its rank count; returns the new wall_seconds.
+// records its rank count; returns the new wall_seconds. Keeps every byte of the file
+// (chunks appended past HDF5's own end included).
 double record_partial_run(const std::filesystem::path& path, double seconds, int ranks);
 
 // The partial file opened by every rank of a run, each on its own descriptor.
@@ -68,11 +80,12 @@ public:
     const PosixFile& file() const { return file_; }
 
     // Collective: of the tiles `done` (identical on every rank, ascending) with the
-    // checksums recorded for them, those whose data no longer match, on every rank. Each
-    // rank reads its share.
-    std::vector<std::uint64_t> damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums);
+    // checksums recorded for them (and, compressed, where they lie), those whose data no
+    // longer match, on every rank. Each rank reads its share.
+    std::vector<std::uint64_t> damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
+                                       std::span<const StoredChunk> stored);
 
-    // Closes this rank's descriptor (after every write of the rank's TileWriter).
+    // Closes this rank's descriptor (after every write of the rank's writers).
     void close() { file_.close(); }
 
 private:
@@ -83,11 +96,84 @@ private:
     PosixFile file_;
 };
 
-// One rank's writer: tiles computed one after the other are placed in their chunk layout in
-// a buffer, and each run of consecutive tiles leaves as one write per dataset when the
-// buffer is full, when a tile does not follow the last, or on flush(). Two buffers: one
-// is written (by a thread of its own, posix_file.hpp) while the next fills, so the copy
-// into the file system overlaps with counting.
+// Places a tile's values, row-major over its box, in the layout of its chunk: row-major
+// over the tile shape, the points of an edge tile's chunk beyond the grid zero. `chunk`
+// holds tiling.tile_points() values; returns it, or `values` itself when the tile is full.
+template <class T>
+std::span<const T> in_chunk_layout(const Tiling& tiling, std::uint64_t tile, std::span<const T> values, std::vector<T>& chunk)
+{
+    const Box box = tiling.box(tile);
+    if (box.count == tiling.tile_shape()) return values;
+    chunk.assign(tiling.tile_points(), T{0});
+    copy_box(box, std::as_bytes(values).data(), box.start, box.count, reinterpret_cast<std::byte*>(chunk.data()), box.start,
+             tiling.tile_shape(), sizeof(T));
+    return chunk;
+}
+
+// Compressed tiles on their way to rank 0's ChunkAppender: those a rank counted since it
+// last flushed, their stored chunks one after the other.
+struct TileBatch {
+    // Per tile: tile, checksum, bytes of its stored counts, bytes of its stored outcomes.
+    std::vector<std::uint64_t> entries;
+    std::vector<std::byte> data;  // each tile's counts then outcomes, in entry order
+
+    static constexpr std::size_t words = 4;
+    std::size_t tiles() const { return entries.size() / words; }
+    bool empty() const { return entries.empty(); }
+    void clear()
+    {
+        entries.clear();
+        data.clear();
+    }
+    // The tiles' reports, in order.
+    std::vector<TileReport> reports() const;
+    // One buffer holding the batch, for a message: [tiles][entries][data].
+    std::vector<std::byte> pack() const;
+    // The batch a message holds; std::runtime_error if it is not one.
+    static TileBatch unpack(std::span<const std::byte> message);
+};
+
+// Rank 0's writer of compressed tiles: batches are copied into a buffer, written at the
+// end of the file (by a thread of its own, so the copy into the file system overlaps with
+// counting and serving; at once when no write is in progress, else gathered with the
+// next batches) and reported written with their addresses.
+class ChunkAppender {
+public:
+    // Appends from byte `start` on (the file's end: nothing there is overwritten).
+    ChunkAppender(PartialFile& file, std::uint64_t start, std::uint64_t buffer_bytes);
+
+    void add(const TileBatch& batch);
+    // The tiles written since the last call (without waiting for writes in progress).
+    std::vector<AppendedTile> written();
+    // Writes what is buffered and waits for every write; the tiles written since the
+    // last call.
+    std::vector<AppendedTile> flush();
+    // The next tile's address: the end of the data.
+    std::uint64_t end() const { return end_; }
+
+private:
+    struct Buffer {
+        std::vector<std::byte> bytes;
+        std::uint64_t at = 0;  // the address of bytes[0]
+        std::vector<AppendedTile> tiles;
+        std::future<void> write;  // valid while being written
+    };
+    void issue();
+    void complete(Buffer& b);
+
+    PartialFile& file_;
+    std::uint64_t capacity_;
+    std::uint64_t end_;
+    Buffer buffers_[2];
+    int current_ = 0;
+    std::vector<AppendedTile> written_;
+};
+
+// One rank's writer of uncompressed tiles: tiles computed one after the other are placed in
+// their chunk layout in a buffer, and each run of consecutive tiles leaves as one write
+// per dataset when the buffer is full, when a tile does not follow the last, or on
+// flush(). Two buffers: one is written (by a thread of its own, posix_file.hpp) while the
+// next fills, so the copy into the file system overlaps with counting.
 class TileWriter {
 public:
     // buffer_bytes: of counts per buffer, at least one chunk (outcomes take half or a
@@ -100,9 +186,6 @@ public:
     // Writes what is buffered and waits for every write; returns the tiles written since
     // the last call, with their checksums, in the order they were added.
     std::vector<TileReport> flush();
-    // From now on, every tile added is also kept in `store` while its budget lasts (for the
-    // closing pass, final_result.hpp). The store outlives the writer.
-    void retain(RetainedTiles& store) { retained_ = &store; }
 
 private:
     struct Buffer {
@@ -123,27 +206,30 @@ private:
     Buffer buffers_[2];
     int current_ = 0;
     std::vector<TileReport> written_;
-    RetainedTiles* retained_ = nullptr;
 };
 
 // Rank 0's record of finished tiles: kept in memory, written to the partial file's
-// /progress datasets (checksums first, then done flags) at most every `interval` seconds
-// and when asked.
+// /progress datasets (where the tiles lie and their checksums first, then the done flags
+// that vouch for them) at most every `interval` seconds and when asked.
 class Journal {
 public:
-    // `done`, `checksums`: the record so far (a resume), one entry per tile.
-    Journal(PartialFile& file, std::vector<std::uint8_t> done, std::vector<std::uint64_t> checksums,
-            std::chrono::duration<double> interval);
+    // `journal`: the record so far (a resume), one entry per tile.
+    Journal(PartialFile& file, TileJournal journal, std::chrono::duration<double> interval);
 
-    void record(std::span<const TileReport> tiles);
+    void record(std::span<const TileReport> tiles);    // uncompressed files
+    void record(std::span<const AppendedTile> tiles);  // compressed files
     // Writes what changed since the last write, if `interval` has passed or `now` is true.
     void checkpoint(bool now);
+    // Something changed and `interval` has passed since the last write.
+    bool due() const;
     std::uint64_t tiles_done() const { return tiles_done_; }
+    const TileJournal& tiles() const { return journal_; }
 
 private:
+    void mark(std::uint64_t tile, std::uint64_t checksum);
+
     PartialFile& file_;
-    std::vector<std::uint8_t> done_;
-    std::vector<std::uint64_t> checksums_;
+    TileJournal journal_;
     std::chrono::duration<double> interval_;
     std::chrono::steady_clock::time_point last_;
     std::uint64_t dirty_begin_, dirty_end_ = 0;  // tiles changed since the last write

@@ -1,6 +1,7 @@
 #include "posix_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
 
@@ -17,7 +18,8 @@ namespace {
 }
 }  // namespace
 
-PosixFile::PosixFile(const std::filesystem::path& path) : fd_(::open(path.c_str(), O_RDWR | O_CLOEXEC))
+PosixFile::PosixFile(const std::filesystem::path& path, bool writable)
+    : fd_(::open(path.c_str(), (writable ? O_RDWR : O_RDONLY) | O_CLOEXEC))
 {
     if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "open " + path.string());
 }
@@ -46,6 +48,13 @@ void PosixFile::write_at(std::uint64_t offset, const void* data, std::size_t byt
         offset += static_cast<std::uint64_t>(n);
         bytes -= static_cast<std::size_t>(n);
     }
+}
+
+std::uint64_t PosixFile::size() const
+{
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) fail("stat");
+    return static_cast<std::uint64_t>(st.st_size);
 }
 
 void PosixFile::read_at(std::uint64_t offset, void* data, std::size_t bytes) const

@@ -16,8 +16,9 @@ namespace superball {
 
 class PosixFile {
 public:
-    // Opens an existing file for reading and writing; std::system_error naming it if not.
-    explicit PosixFile(const std::filesystem::path& path);
+    // Opens an existing file for reading and writing (or reading only); std::system_error
+    // naming it if not.
+    explicit PosixFile(const std::filesystem::path& path, bool writable = true);
     ~PosixFile();
     PosixFile(PosixFile&& o) noexcept;
     PosixFile& operator=(PosixFile&&) = delete;
@@ -28,6 +29,8 @@ public:
     // interrupted calls); std::system_error on failure (ENOSPC for a full disk).
     void write_at(std::uint64_t offset, const void* data, std::size_t bytes) const;
     void read_at(std::uint64_t offset, void* data, std::size_t bytes) const;
+    // The file's size in bytes.
+    std::uint64_t size() const;
     // Closes now, reporting failure (the destructor cannot).
     void close();
 

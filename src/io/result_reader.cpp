@@ -13,8 +13,9 @@
 #include <system_error>
 
 #include "job/job.hpp"
+#include "chunk_codec.hpp"
 #include "layout.hpp"
-#include "partial_file.hpp"
+#include "stored_tiles.hpp"
 
 namespace superball {
 
@@ -231,12 +232,32 @@ bool has_superball_marks(const fs::path& path, std::uint64_t size)
 }
 
 // The byte ranges of the file's big raw data, which damaged_global_heap need not search:
-// contiguous datasets, and chunked ones without filters whose chunks lie one after the
-// other (a partial file's). Whatever cannot be told is searched.
+// contiguous datasets, chunked ones without filters whose chunks lie one after the other
+// (an uncompressed partial file's), and the tiles a compressed partial file records done.
+// Whatever cannot be told is searched.
 std::vector<std::pair<std::uint64_t, std::uint64_t>> raw_data_ranges(hid_t file)
 {
     std::vector<std::pair<std::uint64_t, std::uint64_t>> ranges;
-    for (const char* name : {layout::wall_bounces, layout::outcome, layout::tile_done, layout::tile_checksum}) {
+    try {
+        if (h5::object_type(file, layout::tile_stored) == h5::ObjectType::dataset &&
+            h5::object_type(file, layout::tile_done) == h5::ObjectType::dataset) {
+            const h5::Id done_set = h5::open_dataset(file, layout::tile_done);
+            const h5::Id stored_set = h5::open_dataset(file, layout::tile_stored);
+            const h5::Shape ds = h5::dataset_shape_of(done_set), ss = h5::dataset_shape_of(stored_set);
+            if (ds.dims.size() == 1 && ds.bytes == 1 && ss.bytes == 8 && ss.dims == std::vector<hsize_t>{ds.dims[0], 3} &&
+                ds.dims[0] <= max_points) {
+                std::vector<std::uint8_t> done(ds.dims[0]);
+                std::vector<std::uint64_t> stored(3 * ds.dims[0]);
+                h5::check(H5Dread(done_set, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, done.data()), "read");
+                h5::check(H5Dread(stored_set, H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, stored.data()), "read");
+                for (std::size_t t = 0; t < done.size(); ++t) {
+                    if (done[t] == 1) ranges.emplace_back(stored[3 * t], stored[3 * t + 1] + stored[3 * t + 2]);
+                }
+            }
+        }
+    } catch (const h5::Error&) {
+    }
+    for (const char* name : {layout::wall_bounces, layout::outcome, layout::tile_done, layout::tile_checksum, layout::tile_stored}) {
         try {
             if (h5::object_type(file, name) != h5::ObjectType::dataset) continue;
             const h5::Id d = h5::open_dataset(file, name);
@@ -360,10 +381,15 @@ void ResultReader::validate()
     }
     in.kind = kind == layout::kind_result ? FileKind::result : FileKind::partial;
     if (const std::int64_t format = check.integer("superball_format", 0, std::numeric_limits<std::int64_t>::max());
-        format != layout::format_version) {
-        check.fail(fmt::format("attribute superball_format = {}: this version of superball reads format {} only; read the "
-                               "file with the version that wrote it",
-                               format, layout::format_version));
+        format != layout::format_version && !(in.kind == FileKind::result && format >= layout::oldest_result_format &&
+                                              format < layout::format_version)) {
+        check.fail(in.kind == FileKind::result
+                       ? fmt::format("attribute superball_format = {}: this version of superball reads results of format {} "
+                                     "to {}; read the file with the version that wrote it",
+                                     format, layout::oldest_result_format, layout::format_version)
+                       : fmt::format("attribute superball_format = {}: a partial file of format {} is resumed by the version "
+                                     "that wrote it, this one resumes format {} only",
+                                     format, format, layout::format_version));
     }
 
     // The grid's coordinates and axes.
@@ -406,6 +432,14 @@ void ResultReader::validate()
     in.max_bounces = check.integer("max_bounces", 1, max_max_bounces);
     in.software_version = check.text("software_version");
     in.job_toml = check.text("job_toml", max_job_bytes);
+    // The job is printed and resumed from: a damaged text (its bytes sit in HDF5's global
+    // heap, which has no checksum) is refused, not shown.
+    try {
+        parse_job(in.job_toml, "job_toml");
+    } catch (const InputError& e) {
+        check.fail(fmt::format("attribute job_toml is not the text of a valid job ({}): the file is damaged",
+                               printable(e.what())));
+    }
     in.job_fingerprint = check.text("job_fingerprint", max_job_bytes);
     in.mpi_ranks = check.integer("mpi_ranks", 0, std::int64_t{1} << 40);
     in.wall_seconds = check.number("wall_seconds");
@@ -451,6 +485,26 @@ void ResultReader::validate()
         }
     }
 
+    // A result is complete: a resume journal belongs to a run in progress.
+    if (in.kind == FileKind::result && h5::object_type(file_, "/progress") != h5::ObjectType::missing) {
+        std::string journal;
+        if (h5::object_type(file_, layout::tile_done) == h5::ObjectType::dataset) {
+            const h5::Id d = h5::open_dataset(file_, layout::tile_done);
+            const h5::Shape s = h5::dataset_shape_of(d);
+            if (s.type == h5::TypeClass::integer && s.bytes == 1 && s.dims.size() == 1 && s.dims[0] <= max_points &&
+                h5::dataset_storage(d).allocated) {
+                std::vector<std::uint8_t> flags(s.dims[0]);
+                h5::check(H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, flags.data()),
+                          "read " + std::string(layout::tile_done));
+                journal = fmt::format(", /progress/tile_done, recording {} of {} tiles done", std::count(flags.begin(), flags.end(), 1),
+                                      flags.size());
+            }
+        }
+        check.fail(fmt::format("superball_file = result and complete = 1 say the run is complete, but the file holds a resume "
+                               "journal{}: the file contradicts itself",
+                               journal.empty() ? " (/progress), which only a run in progress has" : journal));
+    }
+
     // The data.
     counts_ = check.dataset(layout::wall_bounces);
     outcomes_ = check.dataset(layout::outcome);
@@ -491,8 +545,11 @@ void ResultReader::validate()
     if (in.max_bounces > 65535 && in.count_bytes == 2) {
         check.fail(fmt::format("max_bounces = {} does not fit the 16-bit counts of /wall_bounces", in.max_bounces));
     }
-    check.allocated(counts_, layout::wall_bounces);
-    check.allocated(outcomes_, layout::outcome);
+    // A compressed partial file's chunks are indexed when it becomes the result.
+    if (in.kind == FileKind::result) {
+        check.allocated(counts_, layout::wall_bounces);
+        check.allocated(outcomes_, layout::outcome);
+    }
 
     // Coordinate variables: each axis's samples, a dimension scale attached to its
     // dimension of both datasets (what xarray and netCDF tools read as its coordinate).
@@ -545,29 +602,7 @@ void ResultReader::validate()
         if (!(x == value)) check.fail(fmt::format("{} = {} contradicts attribute fixed_{} = {}", v, x, name, value));
     }
 
-    if (in.kind == FileKind::partial) {
-        validate_partial();
-        return;
-    }
-    // A result is complete: a resume journal belongs to a run in progress.
-    if (h5::object_type(file_, "/progress") != h5::ObjectType::missing) {
-        std::string journal;
-        if (h5::object_type(file_, layout::tile_done) == h5::ObjectType::dataset) {
-            const h5::Id d = h5::open_dataset(file_, layout::tile_done);
-            const h5::Shape s = h5::dataset_shape_of(d);
-            if (s.type == h5::TypeClass::integer && s.bytes == 1 && s.dims.size() == 1 && s.dims[0] <= max_points &&
-                h5::dataset_storage(d).allocated) {
-                std::vector<std::uint8_t> flags(s.dims[0]);
-                h5::check(H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, flags.data()),
-                          "read " + std::string(layout::tile_done));
-                journal = fmt::format(", /progress/tile_done, recording {} of {} tiles done", std::count(flags.begin(), flags.end(), 1),
-                                      flags.size());
-            }
-        }
-        check.fail(fmt::format("superball_file = result and complete = 1 say the run is complete, but the file holds a resume "
-                               "journal{}: the file contradicts itself",
-                               journal.empty() ? " (/progress), which only a run in progress has" : journal));
-    }
+    if (in.kind == FileKind::partial) validate_partial();
 }
 
 void ResultReader::validate_partial()
@@ -583,25 +618,47 @@ void ResultReader::validate_partial()
     }
     tiling_.emplace(in.shape, in.tile_shape);
     in.tiles = tiling_->tiles();
-    // One uncompressed chunk per tile: resume writes each tile's bytes straight to its chunk.
+    // One chunk per tile: uncompressed, each tile's bytes written straight to its chunk;
+    // compressed, shuffle + deflate as in the result, the chunks appended past the HDF5
+    // objects (listed in /progress/tile_stored) and not indexed yet.
+    const h5::Storage counts_storage = h5::dataset_storage(counts_);
+    compressed_ = counts_storage.filters != 0;
     for (const auto& [d, name] : {std::pair{counts_.get(), layout::wall_bounces}, std::pair{outcomes_.get(), layout::outcome}}) {
         const h5::Storage st = h5::dataset_storage(d);
-        if (st.chunk != std::vector<hsize_t>(in.tile_shape.begin(), in.tile_shape.end()) || st.filters != 0) {
-            check.fail(fmt::format("{} is stored {}{}, not in uncompressed chunks of tile_shape ({}) as a partial file is",
+        const bool as_counts = st.filters == counts_storage.filters && st.shuffle == counts_storage.shuffle &&
+                               st.deflate_level == counts_storage.deflate_level;
+        const bool pipeline = compressed_ ? st.filters == 2 && st.shuffle && st.deflate_level >= 1 && st.deflate_level <= 9
+                                          : st.filters == 0;
+        if (st.chunk != std::vector<hsize_t>(in.tile_shape.begin(), in.tile_shape.end()) || !pipeline || !as_counts) {
+            check.fail(fmt::format("{} is stored {}{}, not in chunks of tile_shape ({}), uncompressed or through shuffle and "
+                                   "deflate alike for both datasets, as a partial file is",
                                    name, st.chunk.empty() ? "unchunked" : "in chunks of " + dims_text(st.chunk),
                                    st.filters ? fmt::format(" through {} filters", st.filters) : "",
                                    fmt::join(in.tile_shape, ", ")));
         }
+        if (!compressed_) {
+            check.allocated(d, name);
+        } else {
+            hsize_t chunks = 0;
+            const h5::Id space = h5::space_id(H5Dget_space(d), "H5Dget_space");
+            h5::check(H5Dget_num_chunks(d, space, &chunks), "H5Dget_num_chunks");
+            if (chunks != 0) {
+                check.fail(fmt::format("{} holds chunks ({}), which a compressed partial file never does: its tiles are "
+                                       "in /progress/tile_stored until the run completes; the file is damaged",
+                                       name, chunks));
+            }
+        }
     }
-    for (const char* name : {layout::tile_done, layout::tile_checksum}) {
+    std::vector<const char*> journal{layout::tile_done, layout::tile_checksum};
+    if (compressed_) journal.push_back(layout::tile_stored);
+    for (const char* name : journal) {
         const h5::Id d = check.dataset(name);
         const h5::Shape s = h5::dataset_shape_of(d);
         const std::size_t bytes = name == layout::tile_done ? 1 : 8;
-        if (s.type != h5::TypeClass::integer || s.is_signed || s.bytes != bytes || !s.little_endian ||
-            s.dims != std::vector<hsize_t>{in.tiles}) {
-            check.fail(fmt::format("{} holds {} but tile_shape ({}) makes {} tiles: accepted {} unsigned {}-bit integers, "
-                                   "one per tile",
-                                   name, shape_text(s), fmt::join(in.tile_shape, ", "), in.tiles, in.tiles, 8 * bytes));
+        const std::vector<hsize_t> dims = name == layout::tile_stored ? std::vector<hsize_t>{in.tiles, 3} : std::vector<hsize_t>{in.tiles};
+        if (s.type != h5::TypeClass::integer || s.is_signed || s.bytes != bytes || !s.little_endian || s.dims != dims) {
+            check.fail(fmt::format("{} holds {} but tile_shape ({}) makes {} tiles: accepted {} unsigned {}-bit integers",
+                                   name, shape_text(s), fmt::join(in.tile_shape, ", "), in.tiles, dims_text(dims), 8 * bytes));
         }
         check.allocated(d, name);
     }
@@ -615,6 +672,28 @@ void ResultReader::validate_partial()
               "read " + std::string(layout::tile_checksum));
     for (std::uint64_t t = 0; t < in.tiles; ++t) {
         if (done_[t] > 1) check.fail(fmt::format("{} holds {} for tile {}: accepted 0 or 1", layout::tile_done, done_[t], t));
+    }
+    if (compressed_) {
+        std::vector<std::uint64_t> words(3 * in.tiles);
+        h5::check(H5Dread(h5::open_dataset(file_, layout::tile_stored), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                          words.data()),
+                  "read " + std::string(layout::tile_stored));
+        stored_.resize(in.tiles);
+        const std::uint64_t size = fs::file_size(path_);
+        // A stored chunk inflates to at most 1032 times its size (deflate's limit); a
+        // tile's are never empty.
+        const std::uint64_t chunk_bytes = tiling_->tile_points() * in.count_bytes;
+        for (std::uint64_t t = 0; t < in.tiles; ++t) {
+            stored_[t] = {words[3 * t], words[3 * t + 1], words[3 * t + 2]};
+            const StoredChunk& c = stored_[t];
+            if (done_[t] == 0) continue;
+            if (c.counts_bytes == 0 || c.outcomes_bytes == 0 || c.counts_bytes > chunk_bytes + chunk_bytes / 2 + 64 ||
+                c.outcomes_bytes > chunk_bytes || c.address > size || c.end() > size || c.end() < c.address) {
+                check.fail(fmt::format("{} places done tile {} at bytes {} to {} (+{}), which a file of {} bytes cannot "
+                                       "hold: the file is truncated or damaged",
+                                       layout::tile_stored, t, c.address, c.address + c.counts_bytes, c.outcomes_bytes, size));
+            }
+        }
     }
     in.tiles_done = static_cast<std::uint64_t>(std::count(done_.begin(), done_.end(), std::uint8_t{1}));
     verified_.assign(in.tiles, 0);
@@ -650,8 +729,56 @@ std::vector<std::uint8_t> ResultReader::tiles_done() const { return done_; }
 
 std::vector<std::uint64_t> ResultReader::tile_checksums() const { return sums_; }
 
+std::vector<StoredChunk> ResultReader::tile_stored() const { return stored_; }
+
+const PosixFile& ResultReader::raw() const
+{
+    if (!raw_) raw_.emplace(path_, false);
+    return *raw_;
+}
+
+void ResultReader::read_stored(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const
+{
+    const Extent& ts = info_.tile_shape;
+    const std::uint64_t n = tiling_->tile_points();
+    std::vector<std::uint32_t> chunk_counts(n);
+    std::vector<std::uint8_t> chunk_outcomes(n);
+    std::vector<std::byte> bytes;
+    ChunkDecoder decoder;
+    tiling_->for_each_meeting(box, [&](std::uint64_t t) {
+        const Box tb = tiling_->box(t);
+        const Box part = intersect(tb, box);
+        if (done_[t] == 0) return;  // masked by the caller
+        const StoredChunk& c = stored_[t];
+        bytes.resize(c.counts_bytes + c.outcomes_bytes);
+        raw().read_at(c.address, bytes.data(), bytes.size());
+        const std::span<const std::byte> all(bytes);
+        if (!decoder.counts(all.first(c.counts_bytes), info_.count_bytes, chunk_counts) ||
+            !decoder.outcomes(all.subspan(c.counts_bytes), chunk_outcomes)) {
+            throw FormatError(fmt::format("{}: tile {} is recorded done in {}, but its stored chunks (at byte {}) do not "
+                                          "decompress to one tile: the file is damaged",
+                                          path_.string(), t, layout::tile_done, c.address));
+        }
+        copy_box(part, reinterpret_cast<const std::byte*>(chunk_counts.data()), tb.start, ts,
+                 reinterpret_cast<std::byte*>(counts.data()), box.start, box.count, sizeof(std::uint32_t));
+        copy_box(part, reinterpret_cast<const std::byte*>(chunk_outcomes.data()), tb.start, ts,
+                 reinterpret_cast<std::byte*>(outcomes.data()), box.start, box.count, 1);
+    });
+}
+
 bool ResultReader::tile_intact(std::uint64_t t) const
 {
+    if (compressed_) {
+        const StoredChunk& c = stored_[t];
+        std::vector<std::byte> bytes(c.counts_bytes + c.outcomes_bytes);
+        try {
+            raw().read_at(c.address, bytes.data(), bytes.size());
+        } catch (const std::exception&) {
+            return false;
+        }
+        const std::span<const std::byte> all(bytes);
+        return tile_checksum(t, all.first(c.counts_bytes), all.subspan(c.counts_bytes)) == sums_[t];
+    }
     // The chunks as stored, the bytes the checksum was taken of.
     const std::vector<hsize_t> origin = to_hsize(tiling_->box(t).start);
     std::uint64_t chunk_points = 1;
@@ -745,7 +872,9 @@ std::uint64_t ResultReader::read_checked(const Box& box, std::span<std::uint32_t
 {
     const std::vector<hsize_t> start = to_hsize(box.start), count = to_hsize(box.count);
     const h5::Id memory = h5::simple_space(count);
+    if (compressed_) read_stored(box, counts, outcomes);
     for (const hid_t d : {counts_.get(), outcomes_.get()}) {
+        if (compressed_) break;
         const h5::Id space = h5::space_id(H5Dget_space(d), "H5Dget_space");
         h5::select_box(space, start, count);
         if (d == counts_.get()) {

@@ -20,6 +20,8 @@
 #include "core/input.hpp"
 #include "hdf5.hpp"
 #include "job/tiles.hpp"
+#include "posix_file.hpp"
+#include "stored_tiles.hpp"
 
 namespace superball {
 
@@ -77,6 +79,8 @@ public:
     // Partial files: the journal (flags 0 or 1, checked at open) and the checksums.
     std::vector<std::uint8_t> tiles_done() const;
     std::vector<std::uint64_t> tile_checksums() const;
+    // Compressed partial files: where each tile's stored chunks lie (else empty).
+    std::vector<StoredChunk> tile_stored() const;
     // Partial files: done tiles whose data no longer match their checksums (reads them all).
     std::vector<std::uint64_t> damaged_tiles() const;
 
@@ -101,6 +105,10 @@ private:
     bool tile_intact(std::uint64_t t) const;
     // Checks every done tile that meets `box` and was not checked before.
     void verify_tiles(const Box& box) const;
+    // Compressed partial files: the done tiles' values in `box`, decompressed.
+    void read_stored(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const;
+    // The file's bytes, for a compressed partial file's stored chunks (opened once).
+    const PosixFile& raw() const;
 
     std::filesystem::path path_;
     h5::Id file_;
@@ -109,6 +117,9 @@ private:
     ResultInfo info_;
     std::vector<std::uint8_t> done_;     // partial files: the journal, read once
     std::vector<std::uint64_t> sums_;    // partial files: the checksums, read once
+    std::vector<StoredChunk> stored_;    // compressed partial files: where each tile lies
+    bool compressed_ = false;            // a partial file of compressed tiles
+    mutable std::optional<PosixFile> raw_;
     std::optional<Tiling> tiling_;       // partial files
     // Partial files: tiles whose checksum was checked (read() is const to its callers; the
     // check is done once per tile, not once per read).

@@ -1,6 +1,7 @@
 #include "tiles.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 
 namespace superball {
@@ -10,6 +11,41 @@ std::uint64_t Box::points() const
     std::uint64_t n = 1;
     for (const std::uint64_t c : count) n *= c;
     return n;
+}
+
+Box intersect(const Box& a, const Box& b)
+{
+    Box r{Extent(a.start.size()), Extent(a.start.size())};
+    for (std::size_t d = 0; d < a.start.size(); ++d) {
+        const std::uint64_t lo = std::max(a.start[d], b.start[d]);
+        const std::uint64_t hi = std::min(a.start[d] + a.count[d], b.start[d] + b.count[d]);
+        r.start[d] = lo;
+        r.count[d] = hi > lo ? hi - lo : 0;
+    }
+    return r;
+}
+
+void copy_box(const Box& part, const std::byte* src, const Extent& src_start, const Extent& src_shape, std::byte* dst,
+              const Extent& dst_start, const Extent& dst_shape, std::size_t bytes)
+{
+    const std::size_t dims = part.start.size();
+    if (part.points() == 0) return;
+    const std::size_t row = part.count[dims - 1] * bytes;
+    Extent at(dims, 0);  // index within part of the current row (last axis 0)
+    for (;;) {
+        std::uint64_t s = 0, t = 0;
+        for (std::size_t d = 0; d < dims; ++d) {
+            s = s * src_shape[d] + (part.start[d] + at[d] - src_start[d]);
+            t = t * dst_shape[d] + (part.start[d] + at[d] - dst_start[d]);
+        }
+        std::memcpy(dst + t * bytes, src + s * bytes, row);
+        std::size_t d = dims - 1;
+        while (d-- > 0) {
+            if (++at[d] < part.count[d]) break;
+            at[d] = 0;
+        }
+        if (d == static_cast<std::size_t>(-1)) return;
+    }
 }
 
 Tiling::Tiling(Extent shape, Extent tile) : shape_(std::move(shape)), tile_(std::move(tile))
@@ -43,6 +79,13 @@ Box Tiling::box(std::uint64_t t) const
     return b;
 }
 
+std::uint64_t Tiling::tile_points() const
+{
+    std::uint64_t n = 1;
+    for (const std::uint64_t s : tile_) n *= s;
+    return n;
+}
+
 Extent default_tile_shape(const Extent& shape, std::uint64_t target_points)
 {
     Extent tile = shape;
@@ -61,8 +104,8 @@ Extent default_tile_shape(const Extent& shape, std::uint64_t target_points)
 
 std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks)
 {
-    const std::uint64_t per_rank_share = grid_points / (64 * static_cast<std::uint64_t>(std::max(ranks, 1)));
-    return std::clamp<std::uint64_t>(per_rank_share, 1024, 16384);
+    const std::uint64_t per_rank_share = grid_points / (16 * static_cast<std::uint64_t>(std::max(ranks, 1)));
+    return std::clamp<std::uint64_t>(per_rank_share, 1024, std::uint64_t{1} << 18);
 }
 
 std::vector<std::uint64_t> handout_order(const std::vector<std::uint64_t>& pending, std::uint64_t granule, bool interleave)

@@ -1,7 +1,8 @@
 // Cutting a grid into rectangular tiles. A tile is also the HDF5 chunk of the result,
-// so each tile is written in one piece.
+// so each tile is compressed and written in one piece.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -10,7 +11,7 @@ namespace superball {
 using Extent = std::vector<std::uint64_t>;  // one entry per range axis, first axis slowest
 
 // A finished tile, as its writer reports it: which tile, and the checksum of its data as
-// written (the resume journal keeps it; a resume checks the data against it).
+// stored (the resume journal keeps it; a resume checks the data against it).
 struct TileReport {
     std::uint64_t tile = 0;
     std::uint64_t checksum = 0;
@@ -24,6 +25,15 @@ struct Box {
     std::uint64_t points() const;
 };
 
+// The common part of two boxes (counts 0 along the axes where they do not meet).
+Box intersect(const Box& a, const Box& b);
+
+// Copies the values of box `part` (grid coordinates), `bytes` bytes each, from `src`, a
+// row-major array over the box at `src_start` of shape `src_shape`, into `dst`, likewise;
+// both boxes hold `part`. A run of the last axis at a time.
+void copy_box(const Box& part, const std::byte* src, const Extent& src_start, const Extent& src_shape, std::byte* dst,
+              const Extent& dst_start, const Extent& dst_shape, std::size_t bytes);
+
 class Tiling {
 public:
     // shape: grid points per axis; tile: points per axis of a full tile (clipped to shape).
@@ -36,6 +46,11 @@ public:
 
     // Tile t, row-major over the tiles; edge tiles are smaller.
     Box box(std::uint64_t t) const;
+    // Points of a full tile (an HDF5 chunk holds that many whatever the tile's box).
+    std::uint64_t tile_points() const;
+    // Calls f(t) for every tile meeting box `b` (within the grid), in ascending order.
+    template <class F>
+    void for_each_meeting(const Box& b, F&& f) const;
 
 private:
     Extent shape_;
@@ -44,15 +59,41 @@ private:
     std::uint64_t tiles_ = 0;
 };
 
+template <class F>
+void Tiling::for_each_meeting(const Box& b, F&& f) const
+{
+    const std::size_t dims = b.start.size();
+    Extent lo(dims), hi(dims), at(dims);
+    for (std::size_t d = 0; d < dims; ++d) {
+        if (b.count[d] == 0) return;
+        lo[d] = b.start[d] / tile_[d];
+        hi[d] = (b.start[d] + b.count[d] - 1) / tile_[d];
+        at[d] = lo[d];
+    }
+    for (;;) {
+        std::uint64_t t = 0;
+        for (std::size_t d = 0; d < dims; ++d) t = t * tiles_per_axis_[d] + at[d];
+        f(t);
+        std::size_t d = dims;
+        while (d-- > 0) {
+            if (++at[d] <= hi[d]) break;
+            at[d] = lo[d];
+        }
+        if (d == static_cast<std::size_t>(-1)) return;
+    }
+}
+
 // A tile shape of about `target_points` points: the grid is halved along its currently
 // longest tile side until the tile is small enough, which keeps tiles near-cubic and
 // their sides powers-of-two fractions of the grid.
 Extent default_tile_shape(const Extent& shape, std::uint64_t target_points);
 
-// Target points per tile for `ranks` ranks: enough tiles (about 64 per rank) that the
-// dynamic schedule can balance very unequal costs, tiles big enough (>= 1024 points)
-// that one message and one HDF5 write are amortised, small enough (<= 16384) that a
-// rank's memory stays small.
+// Target points per tile for `ranks` ranks. A tile is also a chunk of the result,
+// compressed on its own: big enough (up to 2^18 points, 512 KiB of 16-bit counts) that a
+// deflate stream's fixed costs (its header and code tables, an index entry: about 100
+// bytes) stay small against what it holds and readers decompress few chunks; small enough
+// that the dynamic schedule can balance very unequal costs (at least 16 tiles per rank)
+// and never below 1024 points.
 std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks);
 
 // From this many ranks on, a run hands out its tiles interleaved (handout_order).

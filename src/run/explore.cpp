@@ -14,10 +14,12 @@
 #include <utility>
 
 #include "core/count.hpp"
+#include "io/chunk_codec.hpp"
 #include "io/final_result.hpp"
 #include "io/result_metadata.hpp"
 #include "io/layout.hpp"
 #include "io/partial_file.hpp"
+#include "io/placed_chunks.hpp"
 #include "io/posix_file.hpp"
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
@@ -147,16 +149,15 @@ bool is_superball_sidecar(const fs::path& path)
            head.find(":/wall_bounces</DataItem>") != std::string::npos;
 }
 
-// Rank 0: the other files a run writes, OUTPUT.finishing (the result before it takes its
-// name) and the sidecar OUTPUT.xmf, are replaced only if they are superball's too.
+// Rank 0: the other files a run writes, the sidecar OUTPUT.xmf and the undo log
+// OUTPUT.partial.undo (io/placed_chunks.hpp), are replaced only if they are superball's too.
 std::optional<Decision> check_companions(const ExploreSettings& s, const fs::path& out)
 {
     const fs::path sidecar = layout::sidecar_path(out);
     std::error_code ec;
-    const fs::path finishing = layout::finishing_path(out);
-    if (fs::exists(finishing, ec) || fs::is_symlink(finishing, ec)) {
-        const FileIdentity id = identify_file(finishing);
-        if (!id.superball) return refuse_foreign(s, finishing, id, " (where the result is written before it takes its name)");
+    const fs::path undo = PlacedChunks::undo_path(layout::partial_path(out));
+    if ((fs::exists(undo, ec) || fs::is_symlink(undo, ec)) && !PlacedChunks::is_undo_log(undo)) {
+        return refuse_foreign(s, undo, identify_file(undo), " (where the run keeps the undo log of its partial file's changes)");
     }
     // A result named *.xmf, or with a colon in its name, gets no sidecar (xdmf_unsupported).
     const bool gets_sidecar = sidecar != out && out.filename().string().find(':') == std::string::npos;
@@ -197,9 +198,17 @@ Decision decide(const ExploreSettings& s, const fs::path& out, const Job& job)
     std::error_code ec;
     const fs::path partial = layout::partial_path(out);
     if (fs::exists(partial, ec) || fs::is_symlink(partial, ec)) {
+        // A run stopped while its partial file was being made the result: the file as it
+        // was before, first (io/placed_chunks.hpp).
+        std::string undone;
+        if (fs::is_regular_file(partial, ec) && PlacedChunks::undo_interrupted_changes(partial)) {
+            undone = "the run before stopped while finishing " + partial.string() + ": its changes were undone; ";
+        }
         Decision d = decide_partial(s, partial, job);
+        d.message = undone + d.message;
         return d.verdict == Verdict::fresh ? check_writable(out, std::move(d)) : d;
     }
+    PlacedChunks::discard_undo(partial);  // a log left by a run that finished: nothing to undo
     if (fs::exists(out, ec) || fs::is_symlink(out, ec)) {
         Decision d = decide_output(s, out, job);
         return d.verdict == Verdict::fresh ? check_writable(out, std::move(d)) : d;
@@ -217,17 +226,25 @@ double peak_rss_mib()
 
 void broadcast(const mpi::Comm& comm, PartialLayout& l)
 {
-    std::vector<std::uint64_t> v{l.counts_at, l.outcomes_at, l.done_at, l.checksums_at, l.count_bytes, l.chunk_points, l.tiles};
+    std::vector<std::uint64_t> v{l.compressed ? 1u : 0u, l.level, l.counts_at, l.outcomes_at, l.done_at, l.checksums_at,
+                                 l.stored_at, l.count_bytes, l.chunk_points, l.tiles};
     comm.broadcast(v);
-    l = {v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+    l = {v[0] != 0, v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
 }
 
-// Counts tiles and hands them to the writer (TileWork).
+// Counts tiles and hands them on: compressed, into a batch that goes to rank 0 with the
+// rank's reports (TileWork::flush); uncompressed, to the rank's TileWriter.
 class Work final : public TileWork {
 public:
-    Work(const Job& job, const Grid& grid, TileWriter& writer, const Tiling& tiling, CountKernel k)
-        : job_(job), grid_(grid), writer_(writer), tiling_(tiling), counter_(kernel_for(grid, k), job.max_bounces)
+    Work(const Job& job, const Grid& grid, const Tiling& tiling, const PartialLayout& layout, TileWriter* writer, CountKernel k)
+        : job_(job),
+          grid_(grid),
+          tiling_(tiling),
+          layout_(layout),
+          writer_(writer),
+          counter_(kernel_for(grid, k), job.max_bounces)
     {
+        if (layout.compressed) encoder_.emplace(static_cast<int>(layout.level));
     }
 
     void compute(std::uint64_t t, const Serve& serve) override
@@ -246,12 +263,25 @@ public:
             counter_.all(starts_, runs_, counts_, outcomes_, serve);
             counted += starts_.size();
         }
-        writer_.add(t, counts_, outcomes_);
+        if (writer_) {
+            writer_->add(t, counts_, outcomes_);
+        } else {
+            compress(t);
+        }
         points += starts_.size();
         add_to_histogram(outcomes_);
     }
 
-    std::vector<TileReport> flush() override { return writer_.flush(); }
+    Flushed flush() override
+    {
+        if (writer_) return {writer_->flush(), {}};
+        Flushed f{batch_.reports(), batch_.pack()};
+        batch_.clear();
+        return f;
+    }
+
+    // A rank's compressed tiles leave at least every 4 MiB.
+    bool should_flush() const override { return batch_.data.size() >= (std::size_t{4} << 20); }
 
     // The four codes from three sums the compiler vectorises (bit 0, bit 1, both bits):
     // 16 bytes or more per instruction instead of a counter increment per point, which
@@ -286,15 +316,30 @@ public:
     std::uint64_t points = 0;
 
 private:
+    // The tile's chunks as the result stores them, from memory, once: into the batch.
+    void compress(std::uint64_t t)
+    {
+        const std::span<const std::uint32_t> c = in_chunk_layout<std::uint32_t>(tiling_, t, counts_, chunk_counts_);
+        const std::span<const std::uint8_t> o = in_chunk_layout<std::uint8_t>(tiling_, t, outcomes_, chunk_outcomes_);
+        const std::size_t at = batch_.data.size();
+        const std::size_t cb = encoder_->counts(c, layout_.count_bytes, batch_.data);
+        const std::size_t ob = encoder_->outcomes(o, batch_.data);
+        const std::span<const std::byte> stored(batch_.data.data() + at, cb + ob);
+        batch_.entries.insert(batch_.entries.end(), {t, tile_checksum(t, stored.first(cb), stored.subspan(cb)), cb, ob});
+    }
+
     const Job& job_;
     const Grid& grid_;
-    TileWriter& writer_;
     const Tiling& tiling_;
+    const PartialLayout& layout_;
+    TileWriter* writer_;
+    std::optional<ChunkEncoder> encoder_;
+    TileBatch batch_;
     TileCounter counter_;
     Starts starts_;
     std::vector<ModelRun> runs_;
-    std::vector<std::uint32_t> counts_;
-    std::vector<std::uint8_t> outcomes_;
+    std::vector<std::uint32_t> counts_, chunk_counts_;
+    std::vector<std::uint8_t> outcomes_, chunk_outcomes_;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t)
@@ -352,8 +397,8 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const Grid grid(job);
     Extent tile_shape;
     PartialLayout layout;
-    std::vector<std::uint8_t> done;
-    std::vector<std::uint64_t> checksums;
+    TileJournal journal;
+    double earlier_seconds = 0;  // of the runs before a resume
     std::int64_t failed = 0;
     std::string failure;
     if (comm.is_root()) {
@@ -362,14 +407,14 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
                 const Tiling tiling = default_tiling(job, comm.size());
                 tile_shape = tiling.tile_shape();
                 layout = create_partial(partial, job, grid, tiling, comm.size());
-                done.assign(tiling.tiles(), 0);
-                checksums.assign(tiling.tiles(), 0);
+                journal.done.assign(tiling.tiles(), 0);
+                journal.checksums.assign(tiling.tiles(), 0);
             } else {
                 const ResultReader reader(partial);
                 tile_shape = reader.info().tile_shape;
                 layout = partial_layout(partial, Tiling(grid.shape(), tile_shape));
-                done = reader.tiles_done();
-                checksums = reader.tile_checksums();
+                journal = {reader.tiles_done(), reader.tile_checksums(), reader.tile_stored()};
+                earlier_seconds = reader.info().wall_seconds;
             }
         } catch (const std::exception& e) {
             failed = 1;
@@ -388,17 +433,26 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
 
     // The tiles to compute, on every rank; a resume first checks the tiles already done.
     std::vector<std::uint64_t> done_tiles;
-    for (std::uint64_t t = 0; t < done.size(); ++t) {
-        if (done[t] != 0) done_tiles.push_back(t);
+    for (std::uint64_t t = 0; t < journal.done.size(); ++t) {
+        if (journal.done[t] != 0) done_tiles.push_back(t);
     }
     comm.broadcast(done_tiles);
     if (plan.mode == PlanMode::resume) {
-        std::vector<std::uint64_t> sums;  // of the done tiles: rank 0 read them
+        std::vector<std::uint64_t> sums, where;  // of the done tiles: rank 0 read them
         if (comm.is_root()) {
-            for (const std::uint64_t t : done_tiles) sums.push_back(checksums[t]);
+            for (const std::uint64_t t : done_tiles) {
+                sums.push_back(journal.checksums[t]);
+                if (layout.compressed) {
+                    const StoredChunk& c = journal.stored[t];
+                    where.insert(where.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
+                }
+            }
         }
         comm.broadcast(sums);
-        if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums); !bad.empty()) {
+        comm.broadcast(where);
+        std::vector<StoredChunk> stored(where.size() / 3);
+        for (std::size_t i = 0; i < stored.size(); ++i) stored[i] = {where[3 * i], where[3 * i + 1], where[3 * i + 2]};
+        if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums, stored); !bad.empty()) {
             file.close();
             throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
                                          "checksum written with them; refusing to resume onto it: --overwrite to start "
@@ -417,81 +471,120 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
             }
         }
     }
-    std::optional<Journal> journal;
+    // Rank 0 records the tiles done, and writes the compressed ones (from the end of the
+    // file: whatever an interrupted run wrote past its last record stays unused).
+    std::optional<Journal> record;
+    std::optional<ChunkAppender> appender;
     if (comm.is_root()) {
         RunStart start{plan.output, plan.note, comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(),
                        done_tiles.size(), 0};
         for (const std::uint64_t t : done_tiles) start.points_done += tiling.box(t).points();
         observer.started(start);
-        journal.emplace(file, std::move(done), std::move(checksums), std::chrono::duration<double>(job.checkpoint_seconds));
+        record.emplace(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds));
+        if (layout.compressed) appender.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
     }
 
-    // Writes leave in pieces of at least one alignment unit (and 4 MiB of counts), and
-    // blocks of tiles are multiples of one where they can be, so that ranks rarely share a
-    // stripe. Not larger: a rank waits at the end of its run for its last buffer to reach
-    // the file system, and with 8 MiB that wait cost a quarter of `explore -n 2`'s speed on
-    // the 4096^2 slice (1.54e8 against 2.03e8 points/s, medians of 5 interleaved runs); 2 MiB
-    // was no faster and made more than 3 write calls per million points at 8192^2.
-    const std::uint64_t buffer = std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment);
-    // The closing pass from memory (settings.closing_memory_ranks): decided alike on every
-    // rank, from the grid alone.
-    std::optional<RetainedTiles> kept;
-    {
-        // The largest share of the closing pass: whole result chunks, as many as the
-        // rank with the most gets.
-        const Tiling chunks = result_chunks(grid.shape());
-        const auto ranks = static_cast<std::uint64_t>(comm.size());
-        const std::uint64_t share = (chunks.tiles() + ranks - 1) / ranks * chunks.box(0).points() * (layout.count_bytes + 1);
-        if (comm.size() >= settings.closing_memory_ranks && share <= settings.closing_memory_bytes / 2) {
-            kept.emplace(layout.counts_chunk(), layout.outcomes_chunk(), settings.closing_memory_bytes / 2);
-        }
-    }
-    TileWriter writer(file, buffer);
-    if (kept) writer.retain(*kept);
-    Work work(job, grid, writer, tiling, settings.kernel);
-    const TilesDone on_done = [&](std::span<const TileReport> tiles, int) {
-        journal->record(tiles);
+    // Uncompressed tiles: each rank writes its own, in pieces of at least one alignment
+    // unit (and 4 MiB of counts), and blocks of tiles are multiples of one where they can
+    // be, so that ranks rarely share a stripe. Not larger: a rank waits at the end of its
+    // run for its last buffer to reach the file system, and with 8 MiB that wait cost a
+    // quarter of `explore -n 2`'s speed on the 4096^2 slice (1.54e8 against 2.03e8
+    // points/s, medians of 5 interleaved runs); 2 MiB was no faster and made more than 3
+    // write calls per million points at 8192^2.
+    std::optional<TileWriter> writer;
+    if (!layout.compressed) writer.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
+    Work work(job, grid, tiling, layout, writer ? &*writer : nullptr, settings.kernel);
+    const auto recorded = [&](std::span<const AppendedTile> tiles) {
+        record->record(tiles);
         std::uint64_t points = 0;
-        for (const TileReport& r : tiles) points += tiling.box(r.tile).points();
-        observer.tiles_done(tiles.size(), points);
-        journal->checkpoint(false);
+        for (const AppendedTile& a : tiles) points += tiling.box(a.tile).points();
+        if (!tiles.empty()) observer.tiles_done(tiles.size(), points);
+    };
+    // The journal written, and, for compressed tiles, every tile written so far recorded
+    // first and then covered by the file's HDF5 end (PlacedChunks::cover): between two
+    // checkpoints the partial file is a consistent HDF5 file holding every tile it records.
+    const auto checkpoint = [&] {
+        if (appender) recorded(appender->flush());
+        record->checkpoint(true);
+        if (appender) PlacedChunks::cover(partial);
+    };
+    const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
+        if (appender) {
+            const TileBatch batch = TileBatch::unpack(payload);
+            const std::vector<TileReport> carried = batch.reports();
+            if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
+                    return a.tile == b.tile && a.checksum == b.checksum;
+                })) {
+                throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
+            }
+            appender->add(batch);
+            recorded(appender->written());
+        } else {
+            record->record(tiles);
+            std::uint64_t points = 0;
+            for (const TileReport& r : tiles) points += tiling.box(r.tile).points();
+            observer.tiles_done(tiles.size(), points);
+        }
+        if (record->due()) checkpoint();
     };
     ScheduleSettings schedule;
-    schedule.granule = std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
+    // and the granule only groups tiles for the interleaved hand-out.
+    schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
     pending = handout_order(pending, schedule.granule, comm.size() >= settings.interleave_ranks);
     const auto compute_start = std::chrono::steady_clock::now();
     const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule);
-    const double compute_seconds = comm.broadcast(seconds_since(compute_start));
-    if (comm.is_root()) {
-        observer.computed(compute_seconds);
-        journal->checkpoint(true);
-    }
-    file.close();
+    const auto compute_end = std::chrono::steady_clock::now();
+    const double compute_seconds = comm.broadcast(std::chrono::duration<double>(compute_end - compute_start).count());
+    if (comm.is_root()) observer.computed(compute_seconds);
 
-    // The run's figures, in the partial file (a stop) or the result (complete).
+    // The last tiles written and recorded; the run's figures, in the partial file (a stop)
+    // or the result (complete), by rank 0 alone once every rank has closed the file.
     std::int64_t ok = 1;
-    double total_seconds = 0;
+    FinishReport finish;
     if (comm.is_root()) {
         try {
-            total_seconds = record_partial_run(partial, seconds_since(started), comm.size());
+            if (r.interrupted) {
+                checkpoint();
+            } else {
+                // The result's figures and index come next: the journal needs no cover.
+                if (appender) recorded(appender->flush());
+                record->checkpoint(true);
+            }
         } catch (const std::exception& e) {
             ok = 0;
-            failure = fmt::format("recording the run in {} failed: {}", partial.string(), e.what());
+            failure = e.what();
+        }
+    }
+    file.close();
+    comm.barrier();
+    if (comm.is_root() && ok == 1) {
+        try {
+            const double seconds = seconds_since(started);
+            if (r.interrupted) {
+                record_partial_run(partial, seconds, comm.size());
+            } else {
+                observer.finishing();
+                finish = finish_result(partial, plan.output, tiling, layout, record->tiles(),
+                                       {comm.size(), earlier_seconds + seconds, true});
+            }
+        } catch (const std::exception& e) {
+            ok = 0;
+            failure = fmt::format("{} {} failed: {}", r.interrupted ? "recording the run in" : "finishing the result from",
+                                  partial.string(), e.what());
         }
     }
     if (comm.broadcast(ok) == 0) {
         comm.broadcast(failure);
         throw RunError(failure);
     }
-    total_seconds = comm.broadcast(total_seconds);
     if (!r.interrupted) {
-        if (comm.is_root()) observer.finishing();
-        const Retained retained{kept ? &tiling : nullptr, kept ? &*kept : nullptr};
-        const FinishReport f = write_result(partial, plan.output, job, grid, comm, {comm.size(), total_seconds, true}, retained);
-        summary.finish_seconds = f.seconds;
-        summary.raw_bytes = f.raw_bytes;
-        summary.result_bytes = f.file_bytes;
-        summary.sidecar_note = f.sidecar_note;
+        // From the last tile counted to the result under its name.
+        summary.finish_seconds = comm.broadcast(comm.is_root() ? seconds_since(compute_end) : 0.0);
+        summary.raw_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(finish.raw_bytes)));
+        summary.result_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(finish.file_bytes)));
+        summary.sidecar_note = finish.sidecar_note;
+        comm.broadcast(summary.sidecar_note);
     }
 
     std::vector<std::uint64_t> totals = work.histogram;

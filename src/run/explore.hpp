@@ -4,7 +4,8 @@
 //   plan:   rank 0 decides what to do with the output (a new run, a resume, nothing to
 //           do, or a refusal naming why), the others are told; the grid is cut into tiles.
 //   run:    tiles are scheduled over the ranks, counted, written and recorded done.
-//   finish: the result is closed consistent, complete or resumable.
+//   finish: rank 0 makes the partial file the result in place (io/final_result.hpp), or
+//           records the interrupted run in it, resumable.
 //
 // Progress goes to a RunObserver (rank 0 only); a stop is asked for through a predicate
 // polled on every rank (StopSignals::requested for the command line).
@@ -36,14 +37,6 @@ struct ExploreSettings {
     // From this many ranks on, tiles are handed out interleaved (job/tiles.hpp,
     // handout_order); tests set 1 to interleave at any rank count.
     int interleave_ranks = interleave_ranks_default;
-    // From this many ranks on, each rank keeps the tiles it computes in memory for the
-    // closing pass (io/retained_tiles.hpp), if its share of the result fits in half of
-    // closing_memory_bytes; its tiles are kept up to the other half, the rest read back
-    // from the partial file. (Below it the closing pass reads the partial file: on one
-    // machine it mostly comes from the page cache, and a rank's memory stays the same
-    // whatever the grid.) Tests set 1 to keep tiles at any rank count.
-    int closing_memory_ranks = 64;
-    std::uint64_t closing_memory_bytes = std::uint64_t{512} << 20;
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]
@@ -76,7 +69,7 @@ struct RunSummary {
     std::uint64_t points_counted = 0;     // of which counted by the kernel (fewer with refinement)
     std::vector<std::uint64_t> outcomes;  // histogram of this run's points by outcome code
     double compute_seconds = 0;           // from the first tile handed out to the last one done
-    double finish_seconds = 0;            // writing the result from the partial file
+    double finish_seconds = 0;            // from the last tile counted to the result under its name
     std::uint64_t raw_bytes = 0;          // of the data, uncompressed
     std::uint64_t result_bytes = 0;       // of the result file
     std::string sidecar_note;             // "sidecar: PATH", or why the result has none

@@ -3,6 +3,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cstring>
 #include <deque>
 #include <stdexcept>
 
@@ -16,7 +17,8 @@ constexpr int tag_up = 21;
 constexpr int tag_down = 22;
 
 // Up message: {flags, weight, unstarted, received, idle, groups, per group: rank, n, n
-// (tile, checksum) pairs; ranges, then (first, count) per range}. The weight is the number
+// (tile, checksum) pairs, payload bytes b, the payload in ceil(b / 8) words; ranges, then
+// (first, count) per range}. The weight is the number
 // of computing ranks the sender speaks for (1, or a node); unstarted, the most unstarted
 // tiles one rank holds, of the sender and the ranks it serves (what asking it for tiles
 // back can split; a node of many ranks with one tile each has nothing to give); received, the tiles its server has assigned
@@ -167,6 +169,7 @@ public:
                 work_.compute(pending_[i], serve_);
                 ++stats.tiles;
                 ++unflushed_;
+                if (work_.should_flush()) report_own();
                 after_tile();
                 continue;
             }
@@ -340,15 +343,20 @@ private:
         next_report_ = now() + settings_.report_seconds;
         if (unflushed_ == 0 || !computes_) return;
         unflushed_ = 0;
-        const std::vector<TileReport> reports = work_.flush();
-        if (reports.empty()) return;
+        const Flushed f = work_.flush();
+        if (f.reports.empty()) return;
         ++stats.flushes;
         if (root_) {
-            record(reports, world_rank_);
+            record(f.reports, world_rank_, f.payload);
             return;
         }
-        outbox_.insert(outbox_.end(), {static_cast<std::uint64_t>(world_rank_), reports.size()});
-        for (const TileReport& r : reports) outbox_.insert(outbox_.end(), {r.tile, r.checksum});
+        outbox_.insert(outbox_.end(), {static_cast<std::uint64_t>(world_rank_), f.reports.size()});
+        for (const TileReport& r : f.reports) outbox_.insert(outbox_.end(), {r.tile, r.checksum});
+        outbox_.push_back(f.payload.size());
+        const std::size_t at = outbox_.size();
+        outbox_.resize(at + (f.payload.size() + 7) / 8, 0);
+        if (!f.payload.empty()) std::memcpy(outbox_.data() + at, f.payload.data(), f.payload.size());
+        stats.payload_bytes_out += f.payload.size();
         ++outbox_groups_;
     }
 
@@ -358,14 +366,16 @@ private:
     void send_reports_if_due()
     {
         if (outbox_groups_ == 0 || root_) return;
-        if (!children_.empty() && now() < next_forward_) return;
+        // A leader also passes them on once they hold more than a few MiB of data (its node's
+        // compressed tiles), so that its memory stays bounded.
+        if (!children_.empty() && now() < next_forward_ && outbox_.size() < forward_words) return;
         send_up(0);
     }
 
-    void record(std::span<const TileReport> reports, int rank)
+    void record(std::span<const TileReport> reports, int rank, std::span<const std::byte> payload)
     {
         reported_ += reports.size();
-        done_(reports, rank);
+        done_(reports, rank, payload);
     }
 
     void send_up(std::uint64_t flags, const std::vector<Range>& given = {})
@@ -452,16 +462,19 @@ private:
         for (std::uint64_t g = 0; g < groups; ++g) {
             const std::uint64_t rank = msg[at];
             const std::uint64_t n = msg[at + 1];
+            const std::uint64_t payload_bytes = msg[at + 2 + 2 * n];
+            const std::size_t end = at + 3 + 2 * n + (payload_bytes + 7) / 8;
             if (root_) {
                 std::vector<TileReport> reports(n);
                 for (std::uint64_t i = 0; i < n; ++i) reports[i] = {msg[at + 2 + 2 * i], msg[at + 3 + 2 * i]};
-                record(reports, static_cast<int>(rank));
+                const auto* payload = reinterpret_cast<const std::byte*>(msg.data() + at + 3 + 2 * n);
+                record(reports, static_cast<int>(rank), {payload, payload_bytes});
             } else {
                 outbox_.insert(outbox_.end(), msg.begin() + static_cast<std::ptrdiff_t>(at),
-                               msg.begin() + static_cast<std::ptrdiff_t>(at + 2 + 2 * n));
+                               msg.begin() + static_cast<std::ptrdiff_t>(end));
                 ++outbox_groups_;
             }
-            at += 2 + 2 * n;
+            at = end;
         }
         std::vector<Range> given(msg[at]);
         for (std::size_t i = 0; i < given.size(); ++i) given[i] = {msg[at + 1 + 2 * i], msg[at + 2 + 2 * i]};
@@ -742,6 +755,8 @@ private:
     static constexpr double min_pause = 20e-6;
     // Answers wait at most this much longer than when every tile polled.
     static constexpr double poll_interval = 50e-6;
+    // 8 MiB of reports and payloads (in words).
+    static constexpr std::size_t forward_words = std::size_t{1} << 20;
     double last_poll_ = -1;
 
     std::span<const std::uint64_t> pending_;

@@ -24,6 +24,7 @@
 // 64 ranks on, so that a block's cost follows its size).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -49,22 +50,32 @@ struct Serve {
     void operator()() const { call(); }
 };
 
+// What a rank hands over when it flushes: the reports of the tiles it finished since the
+// last flush, in the order it computed them, and, when their data travel with the reports
+// to rank 0 (compressed tiles, for rank 0's writer), those data.
+struct Flushed {
+    std::vector<TileReport> reports;
+    std::vector<std::byte> payload;
+};
+
 // What a rank does with the tiles it is given.
 class TileWork {
 public:
     virtual ~TileWork() = default;
-    // Counts tile `tile` and hands its data to the writer, which may write it now or
-    // keep it for a larger write.
+    // Counts tile `tile` and hands its data on (to the rank's writer, or to be sent).
     virtual void compute(std::uint64_t tile, const Serve& serve) = 0;
-    // Writes every tile computed so far that is not yet written, and returns the reports
-    // of the tiles written since the last call, in the order they were computed. Only a
-    // tile returned here may be recorded done: its data are in the file.
-    virtual std::vector<TileReport> flush() = 0;
+    // Hands over every tile computed so far and not yet handed over: either written to the
+    // file (then only a tile reported here may be recorded done), or in the payload for
+    // rank 0, which records them once it has written them.
+    virtual Flushed flush() = 0;
+    // True when what the rank holds should leave now, before the report period is over
+    // (a bound on its memory).
+    virtual bool should_flush() const { return false; }
 };
 
-// Called on rank 0 for finished tiles (written, see TileWork::flush), with the rank that
-// computed them.
-using TilesDone = std::function<void(std::span<const TileReport> tiles, int rank)>;
+// Called on rank 0 for finished tiles (see TileWork::flush), with the rank that computed
+// them and the payload that came with them.
+using TilesDone = std::function<void(std::span<const TileReport> tiles, int rank, std::span<const std::byte> payload)>;
 // Polled on every rank between tiles: true on any rank stops the run. Every rank then
 // finishes the tile it is computing, drops the rest of its blocks, writes and reports
 // what it computed, and returns (the run is interrupted).
@@ -110,6 +121,7 @@ struct ScheduleStats {
     std::uint64_t messages_in = 0;   // messages it received from the ranks it serves
     std::uint64_t requests_in = 0;   // of which requests for a block
     std::uint64_t messages_out = 0;  // messages it sent to the rank that serves it
+    std::uint64_t payload_bytes_out = 0;  // bytes of its own tiles' payloads it sent
     // Sizes of the blocks a server (rank 0, node leaders) took from its pool, for the
     // ranks it serves and for itself, in order.
     std::vector<std::uint64_t> handed_out;

@@ -20,12 +20,12 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import tile_boxes, tile_checksum  # noqa: E402
+from superball_testing import stored_chunk, tile_boxes, tile_checksum  # noqa: E402
 
 COORDINATE_NAMES = {"canonical": ("xi", "U", "W"), "physical": ("x", "u", "v", "omega")}
 MODEL = {"e_wall": 0.9, "alpha_wall": 0.9, "e_floor": 0.9, "alpha_floor": 0.9}
 INVALID, LEFT, MISSED, CAPPED = range(4)
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 
 
 def samples(low, high, n):
@@ -74,7 +74,7 @@ def tile_shape_for(shape, tiles):
 
 
 def make_result(path, grid, *, data=None, coordinates="canonical", model=None, max_bounces=1000,
-                complete=True, tiles=4, tiles_done=None, g=9.81, radius=0.025):
+                complete=True, tiles=4, tiles_done=None, g=9.81, radius=0.025, compressed=False):
     """Write a result file (complete) or a partial file (complete=False) and return its path.
 
     grid: every coordinate of the system, {name: (min, max, n)} for a range or
@@ -82,7 +82,9 @@ def make_result(path, grid, *, data=None, coordinates="canonical", model=None, m
     data: (wall_bounces, outcome) arrays of the grid's shape (range axes in
           SPEC order), or a function (shape, max_bounces) returning them; default banded_data.
     complete=False: a partial file of `tiles` tiles, the first `tiles_done` of them done
-          (default half) holding the data, the others zero as a run leaves them.
+          (default half) holding the data, the others zero as a run leaves them;
+          compressed=True: the tiles done compressed (shuffle + deflate) past the file's
+          HDF5 objects, /progress/tile_stored saying where, as a run writes them by default.
     """
     model = dict(MODEL if model is None else model)
     names = COORDINATE_NAMES[coordinates]
@@ -112,18 +114,57 @@ def make_result(path, grid, *, data=None, coordinates="canonical", model=None, m
                 if not done[t]:
                     counts[box], outcome[box] = 0, 0
             storage = {"chunks": tuple(tile_shape)}
-        f.create_dataset("wall_bounces", data=counts.astype(count_type), **storage)
-        f.create_dataset("outcome", data=outcome.astype("<u1"), **storage)
+        if not complete and compressed:
+            # Declared as the result's, no chunk written: the tiles go past the end below.
+            storage.update(compression="gzip", compression_opts=4, shuffle=True)
+            f.create_dataset("wall_bounces", shape=shape, dtype=count_type, **storage)
+            f.create_dataset("outcome", shape=shape, dtype="<u1", **storage)
+        else:
+            f.create_dataset("wall_bounces", data=counts.astype(count_type), **storage)
+            f.create_dataset("outcome", data=outcome.astype("<u1"), **storage)
         write_metadata(f, grid, ranges, coordinates, model, max_bounces, path, g, radius, complete)
         if not complete:
             f.attrs["tile_shape"] = np.array(tile_shape, dtype="<u8")
             sums = np.zeros(tiles, dtype="<u8")
             for t, box in enumerate(boxes):
-                if done[t]:
+                if done[t] and not compressed:
                     sums[t] = tile_checksum(f["wall_bounces"], f["outcome"], t, tuple(s.start for s in box))
             f.create_dataset("progress/tile_done", data=done)
             f.create_dataset("progress/tile_checksum", data=sums)
+            if compressed:
+                f.create_dataset("progress/tile_stored", data=np.zeros((tiles, 3), dtype="<u8"))
+    if not complete and compressed:
+        append_compressed_tiles(path, counts.astype(count_type), outcome.astype("<u1"), tile_shape, done)
     return path
+
+
+def append_compressed_tiles(path, counts, outcome, tile_shape, done):
+    """Appends the done tiles' stored chunks past the end of the partial file at `path`
+    (written and closed by h5py, which cuts a file opened for writing to its own end)
+    and records where they lie and their checksums in its journal."""
+    import xxhash  # Debian's python3-xxhash
+    boxes = tile_boxes(counts.shape, tile_shape)
+    end = os.path.getsize(path)
+    stored = np.zeros((len(boxes), 3), dtype="<u8")
+    sums = np.zeros(len(boxes), dtype="<u8")
+    chunks = []
+    for t, box in enumerate(boxes):
+        if not done[t]:
+            continue
+        c, o = np.zeros(tile_shape, counts.dtype), np.zeros(tile_shape, np.uint8)
+        part = tuple(slice(0, b.stop - b.start) for b in box)
+        c[part], o[part] = counts[box], outcome[box]
+        sc, so = stored_chunk(c), stored_chunk(o)
+        stored[t] = (end, len(sc), len(so))
+        sums[t] = xxhash.xxh3_64_intdigest(so, seed=xxhash.xxh3_64_intdigest(sc, seed=t))
+        chunks.append(sc + so)
+        end += len(sc) + len(so)
+    with h5py.File(path, "r+") as f:
+        f["progress/tile_stored"][...] = stored
+        f["progress/tile_checksum"][...] = sums
+    with open(path, "ab") as f:
+        for chunk in chunks:
+            f.write(chunk)
 
 
 def write_metadata(f, grid, ranges, coordinates, model, max_bounces, path, g, radius, complete):

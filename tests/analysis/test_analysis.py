@@ -28,7 +28,7 @@ import bifurcation_plot  # noqa: E402
 import region_map  # noqa: E402
 import superball_results  # noqa: E402
 import trajectory_plot  # noqa: E402
-from fixtures import CAPPED, INVALID, LEFT, MISSED, make_result  # noqa: E402
+from fixtures import CAPPED, INVALID, LEFT, MISSED, banded_data, make_result  # noqa: E402
 from superball_testing import tile_boxes  # noqa: E402
 
 SCRIPTS = ("region_map.py", "trajectory_plot.py", "summary.py", "bifurcation_plot.py")
@@ -415,6 +415,9 @@ class FileLayoutTest(ScriptTestCase):
             "2-D partial": self.result("p2.h5", complete=False, tiles=4, tiles_done=1),
             "3-D partial": self.result("p3.h5", grid=GRID_3D, complete=False, tiles=8, tiles_done=3),
             "partial, no tile done": self.result("p0.h5", complete=False, tiles=6, tiles_done=0),
+            "2-D compressed partial": self.result("c2.h5", complete=False, tiles=4, tiles_done=1, compressed=True),
+            "3-D compressed partial, 32-bit counts": self.result("c3.h5", grid=GRID_3D, complete=False, tiles=8,
+                                                                tiles_done=3, compressed=True, max_bounces=70000),
         }
 
     @unittest.skipUnless(HAVE_BINARY, "SUPERBALL does not name a built binary")
@@ -453,6 +456,26 @@ class FileLayoutTest(ScriptTestCase):
         with superball_results.Result(result) as r:
             counts, outcomes = r.read((slice(None), slice(None)))
         self.assertTrue((outcomes[tiles[1]] == INVALID).all() and (counts[tiles[1]] == 0).all())
+
+    def test_compressed_partial_file_reads_its_stored_tiles(self):
+        """A compressed partial file's tiles done are read from where its journal says, and
+        any index or slice of them equals the data written; the tiles not done read invalid."""
+        counts, outcome = banded_data((24, 18), 1000)
+        result = self.result("cpart.h5", complete=False, tiles=12, tiles_done=5, compressed=True,
+                             data=(counts, outcome))
+        with h5py.File(result, "r") as f:
+            tile_shape = [int(t) for t in f.attrs["tile_shape"]]
+        done = np.zeros(counts.shape, dtype=bool)
+        for box in tile_boxes(counts.shape, tile_shape)[:5]:
+            done[box] = True
+        want_counts, want_outcome = np.where(done, counts, 0), np.where(done, outcome, INVALID)
+        with superball_results.Result(result) as r:
+            for index in [(slice(None), slice(None)), (slice(3, 17, 2), slice(None, None, 5)), (4, slice(2, 20)),
+                          (slice(None), 7), (23, 17)]:
+                with self.subTest(index=index):
+                    got_counts, got_outcome = r.read(index)
+                    np.testing.assert_array_equal(got_counts, want_counts[index])
+                    np.testing.assert_array_equal(got_outcome, want_outcome[index])
 
     def test_values_are_checked_naming_the_object_and_the_point(self):
         cases = [

@@ -166,34 +166,46 @@ class Explore(unittest.TestCase):
             self.assertIn('DATASET "wall_bounces"', r.stdout)
 
     def test_large_grids_get_large_chunks(self):
-        """Chunks of at least 256 KiB of counts on large grids (for readers and the
-        compressor), whatever the tiles of the run."""
-        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 1024 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 768 }',
-                                      run="max_bounces = 1000\ntile_points = 1024"))
+        """The result's chunks are the run's tiles: on large grids, by default, of at least
+        256 KiB of counts (for readers and the compressor)."""
+        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 2048 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 2048 }'))
         out = self.path("big.h5")
         self.explore(job, out, 2)
         with h5py.File(out, "r") as f:
             chunks = f["wall_bounces"].chunks
             self.assertGreaterEqual(np.prod(chunks) * 2, 256 * 1024, chunks)
-        self.assertLess(os.path.getsize(out), 0.02 * 1024 * 768 * 3)
+        self.assertLess(os.path.getsize(out), 0.02 * 2048 * 2048 * 3)
+        # Tiles set by the job are the chunks too.
+        small = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 256 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 192 }',
+                                        run="max_bounces = 1000\ntile_points = 1024"), "small.toml")
+        self.explore(small, self.path("small.h5"), 2)
+        with h5py.File(self.path("small.h5"), "r") as f:
+            self.assertTrue(512 < np.prod(f["wall_bounces"].chunks) <= 1024, f["wall_bounces"].chunks)
 
     def test_ten_billion_points_are_not_filled(self):
-        """Creating the file of a 10^10-point job allocates 30 GB of chunks but writes none of
-        them: the data are never filled, only the journal (9 bytes a tile) and metadata."""
-        job = self.write_job(job_text('xi = { min = 0.0, max = 1.0, n = 100000 }\nU = -1.0\n'
-                                      'W = { min = -3.0, max = 3.0, n = 100000 }'))
-        out = self.path("huge.h5")
-        start = time.time()
-        r = self.explore(job, out, 1, ["--stop-after", "0"], expect=1)
-        self.assertIn("--resume", r.stderr)
-        st = os.stat(out + ".partial")
-        self.assertGreaterEqual(st.st_size, 3 * 10**10)        # every chunk allocated...
-        self.assertLess(st.st_blocks * 512, 64 * 2**20, st)     # ...and none written
-        self.assertLess(time.time() - start, 60)
-        # Reading it reads the tiles done, not 30 GB of nothing.
-        info = subprocess.run([SUPERBALL, "info", out], capture_output=True, text=True, timeout=30)
-        self.assertEqual(info.returncode, 0, info.stderr)
-        self.assertRegex(info.stdout, r"complete: +no \(0 of \d+ tiles done\)")
+        """Creating the file of a 10^10-point job writes none of its data: compressed (the
+        default), nothing is allocated for them until tiles are done (the file holds the
+        metadata and the journal, 33 bytes a tile); uncompressed, 30 GB of chunks are
+        allocated but not written. Reading it reads the tiles done, not 30 GB of nothing."""
+        grid = 'xi = { min = 0.0, max = 1.0, n = 100000 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 100000 }'
+        for compression in (4, 0):
+            with self.subTest(compression=compression):
+                job = self.write_job(job_text(grid, run=f"max_bounces = 1000\ncompression = {compression}"),
+                                     f"huge{compression}.toml")
+                out = self.path(f"huge{compression}.h5")
+                start = time.time()
+                r = self.explore(job, out, 1, ["--stop-after", "0"], expect=1)
+                self.assertIn("--resume", r.stderr)
+                st = os.stat(out + ".partial")
+                if compression:
+                    self.assertLess(st.st_size, 64 * 2**20, st)
+                else:
+                    self.assertGreaterEqual(st.st_size, 3 * 10**10)        # every chunk allocated...
+                self.assertLess(st.st_blocks * 512, 64 * 2**20, st)     # ...and none written
+                self.assertLess(time.time() - start, 60)
+                info = subprocess.run([SUPERBALL, "info", out], capture_output=True, text=True, timeout=30)
+                self.assertEqual(info.returncode, 0, info.stderr)
+                self.assertRegex(info.stdout, r"complete: +no \(0 of \d+ tiles done\)")
 
     def test_uncompressed(self):
         job = self.write_job(job_text(CANONICAL_2D, run="max_bounces = 1000\ncompression = 0"))

@@ -25,7 +25,8 @@ command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found: run .ci/install-de
 job_sources=(src/job/job.cpp src/job/job_parse.cpp src/job/spelling.cpp src/core/input.cpp)
 # What ResultReader needs, and the writers of its templates. HDF5 itself is Debian's, not
 # instrumented: coverage guides the fuzzer through our validation, not HDF5's parser.
-result_sources=(src/io/result_reader.cpp src/io/hdf5.cpp src/io/layout.cpp src/io/partial_file.cpp src/io/posix_file.cpp src/io/page_buffer.cpp src/io/retained_tiles.cpp
+result_sources=(src/io/result_reader.cpp src/io/hdf5.cpp src/io/layout.cpp src/io/partial_file.cpp src/io/posix_file.cpp src/io/page_buffer.cpp src/io/placed_chunks.cpp
+                src/io/chunk_codec.cpp src/io/stored_tiles.cpp
                 src/io/result_metadata.cpp src/mpi/mpi.cpp src/job/grid.cpp src/job/tiles.cpp src/core/count.cpp
                 src/core/boundary_planes.cpp src/core/dynamics.cpp)
 # toml_assert.hpp: see there (toml++ 3.3.0 preconditions on the current character are
@@ -48,7 +49,7 @@ cmp -s "$out/generated/superball/version.hpp.tmp" "$out/generated/superball/vers
 rm -f "$out/generated/superball/version.hpp.tmp"
 # shellcheck disable=SC2207
 hdf5=($(pkg-config --cflags hdf5-openmpi libxxhash) -I/usr/include/eigen3 -I"$out/generated")
-hdf5_libs=($(pkg-config --libs hdf5-openmpi libxxhash) -lhdf5_hl -lfmt $(mpicxx --showme:link))
+hdf5_libs=($(pkg-config --libs hdf5-openmpi libxxhash libdeflate) -lhdf5_hl -lfmt $(mpicxx --showme:link))
 
 # build NAME DEPENDENCIES -- SOURCES... -- EXTRA FLAGS...: rebuilds build/fuzz/NAME when a
 # source, a file of DEPENDENCIES (a find expression's paths) or this script is newer than

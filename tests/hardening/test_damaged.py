@@ -21,9 +21,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import h5py
 import numpy as np
+import xxhash  # Debian's python3-xxhash
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from superball_testing import SOURCE, interrupted_run, mpi_env, superball_binary, tile_boxes, tile_checksum  # noqa: E402
+from superball_testing import SOURCE, interrupted_run, mpi_env, stored_chunk, superball_binary  # noqa: E402
 
 ANALYSIS = os.path.join(SOURCE, "analysis")
 PYTHON = os.environ.get("SUPERBALL_PYTHON") or "/usr/bin/python3"
@@ -155,6 +156,16 @@ def in_chunk(dataset, chunk, at=0.5):
     return offset
 
 
+def in_stored_tile(tile, at=0.5):
+    """An offset inside the stored (compressed) bytes of a compressed partial file's tile,
+    where /progress/tile_stored says they lie."""
+    def offset(path):
+        with h5py.File(path, "r") as f:
+            start, counts, outcomes = (int(v) for v in f["progress/tile_stored"][tile])
+        return start + int((counts + outcomes) * at)
+    return offset
+
+
 def journal_offset(path):
     """Where /progress/tile_done's flags lie in the file."""
     with h5py.File(path, "r") as f:
@@ -170,14 +181,27 @@ def contradicting_journal(f):
 
 
 def forged_done_tile(value):
-    """Tile 0 (done) holding `value` as its outcomes, its checksum recomputed: only the values say it is wrong."""
-    def change(f):
-        box = tile_boxes(f["outcome"].shape, [int(t) for t in f.attrs["tile_shape"]])[0]
-        f["outcome"][box] = value
-        sums = f["progress/tile_checksum"][()]
-        sums[0] = tile_checksum(f["wall_bounces"], f["outcome"], 0, tuple(s.start for s in box))
-        f["progress/tile_checksum"][...] = sums
-    return with_file(change)
+    """Tile 0 (done) holding `value` as its outcomes, stored anew past the file's end with its
+    checksum: only the values say it is wrong."""
+    def damage(path):
+        end = os.path.getsize(path)
+        with h5py.File(path, "r+") as f:
+            shape = [int(t) for t in f.attrs["tile_shape"]]
+            start, counts_bytes, _ = (int(v) for v in f["progress/tile_stored"][0])
+            with open(path, "rb") as raw:
+                raw.seek(start)
+                counts = raw.read(counts_bytes)
+            outcomes = stored_chunk(np.full(shape, value, dtype=np.uint8))
+            where = f["progress/tile_stored"][()]
+            where[0] = (end, len(counts), len(outcomes))
+            f["progress/tile_stored"][...] = where
+            sums = f["progress/tile_checksum"][()]
+            sums[0] = xxhash.xxh3_64_intdigest(outcomes, seed=xxhash.xxh3_64_intdigest(counts, seed=0))
+            f["progress/tile_checksum"][...] = sums
+        assert os.path.getsize(path) == end  # the partial file's HDF5 end covers its tiles
+        with open(path, "ab") as raw:
+            raw.write(counts + outcomes)
+    return damage
 
 
 def swap_scales(f):
@@ -271,7 +295,10 @@ CASES = [
      "contradicts superball_file = partial"),
     ("complete result, journal 1 of 4 tiles", "P", with_file(contradicting_journal), "recording 1 of 4 tiles done"),
     ("unknown kind", "R", set_attribute("superball_file", "draft"), 'superball_file = "draft"'),
-    ("another format", "R", set_attribute("superball_format", np.int64(3)), "superball_format = 3"),
+    ("another format", "R", set_attribute("superball_format", np.int64(4)), "superball_format = 4"),
+    ("an older format of partial file", "P", set_attribute("superball_format", np.int64(2)), "superball_format = 2"),
+    ("chunks written into a compressed partial file's index", "P", write_values("wall_bounces", (1, 1), 7),
+     "/wall_bounces holds chunks"),
     ("unknown coordinate_system", "R", set_attribute("coordinate_system", "polar"), 'coordinate_system = "polar"'),
     ("control characters in a text", "R", set_attribute("superball_file", "\x1b[2Jresult"),
      'superball_file = "\\x1b[2Jresult"'),
@@ -310,7 +337,7 @@ CASES = [
                                                            f["wall_bounces"].__setitem__((9, 9), 4000))),
      "/wall_bounces holds 4000 at (9, 9)"),
     ("journal flag 2", "P", write_values("progress/tile_done", 1, 2), "/progress/tile_done holds 2 for tile 1"),
-    ("a done tile changed", "P", write_values("wall_bounces", (3, 4), 777), "tile 0 (xi 0..19, W 0..14)"),
+    ("a done tile changed", "P", flip(in_stored_tile(0, 0.3)), "tile 0 (xi 0..19, W 0..14)"),
     ("a done tile forged, checksum recomputed", "P", forged_done_tile(200), "/outcome holds 200 at (0, 0)"),
     ("coordinates not increasing", "R", replace_dataset("xi", lambda v: v[[0, 2, 1, *range(3, len(v))]]),
      "/xi is not increasing at 2"),
@@ -334,7 +361,7 @@ CASES = [
     ("bit flip in the global heap's size", "R", flip(after(b"GCOL", 9)), "the global heap at byte"),
     ("bit flip in compressed counts", "R", flip(in_chunk("wall_bounces", 0)), "/wall_bounces"),
     ("bit flip in compressed outcomes", "R", flip(in_chunk("outcome", 0, 0.3)), "/outcome"),
-    ("bit flip in a done tile", "P", flip(in_chunk("outcome", 2, 0.6)), "tile 2 (xi 20..39, W 0..14)"),
+    ("bit flip in a done tile", "P", flip(in_stored_tile(2, 0.9)), "tile 2 (xi 20..39, W 0..14)"),
     ("bit flip in the journal", "P", flip(lambda p: journal_offset(p) + 1),
      "/progress/tile_done holds 16 for tile 1"),
     # Not a superball file at all.
@@ -503,7 +530,7 @@ class Overwrite(unittest.TestCase):
 
     def path(self, name):
         p = os.path.join(self.dir, name)
-        for q in (p, p + ".partial", p + ".finishing"):
+        for q in (p, p + ".partial", p + ".partial.undo"):
             if os.path.isdir(q):
                 shutil.rmtree(q)
             elif os.path.exists(q):
@@ -598,10 +625,10 @@ class Overwrite(unittest.TestCase):
 
     def test_files_the_run_writes_beside_the_result(self):
         out = self.path("beside.h5")
-        finishing, sidecar = out + ".finishing", os.path.join(self.dir, "beside.xmf")
-        make_text(finishing)
-        r = self.assert_refused(out, finishing, ["--overwrite"], "is a text file", "before it takes its name")
-        os.remove(finishing)
+        undo, sidecar = out + ".partial.undo", os.path.join(self.dir, "beside.xmf")
+        make_text(undo)
+        r = self.assert_refused(out, undo, ["--overwrite"], "is a text file", "undo log")
+        os.remove(undo)
         with open(sidecar, "w") as f:
             f.write("my own notes\n")
         self.assert_refused(out, sidecar, [], "is a text file", "ParaView sidecar")

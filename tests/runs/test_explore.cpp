@@ -12,7 +12,9 @@
 
 #include "core/count.hpp"
 #include "core/kernels.hpp"
+#include "io/hdf5.hpp"
 #include "io/layout.hpp"
+#include "io/placed_chunks.hpp"
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
@@ -251,33 +253,73 @@ TEST(RunExplore, InterleavedHandoutGivesTheSameResultAndResumes)
     expect_stopped_and_resumed(job, s, want, 10);
 }
 
-// The closing pass from the tiles the ranks kept in memory (as from 64 ranks on,
-// ExploreSettings::closing_memory_ranks), here at any rank count: the same result; after a
-// resume the tiles of the first run come from the file, the others from memory.
-TEST(RunExplore, ClosingPassFromMemoryGivesTheSameResult)
+// Tiles compressed by the ranks and appended by rank 0, or written uncompressed by each
+// rank to its chunk ([run] compression = 0), 16- and 32-bit counts, full and edge tiles:
+// the same data, fresh and after a stop and resume; the result's chunks are the tiles.
+TEST(RunExplore, CompressedAndUncompressedResultsHoldTheSameData)
 {
     const SharedDir dir;
-    // 2^19 points: two result chunks of 2^18, 2048 tiles of 256 points.
-    const Job job = parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 1024 }\nU = -1.0\n"
-                              "W = { min = -3.0, max = 3.0, n = 512 }\n[run]\nmax_bounces = 1000\ntile_points = 256\n"
-                              "checkpoint_seconds = 0.01\n",
-                              "closing job");
-    const Data want = direct(job);
-    for (const int interleave : {1, interleave_ranks_default}) {
-        ExploreSettings s = settings(dir / "memory.h5", false, true);
-        s.closing_memory_ranks = 1;
-        s.interleave_ranks = interleave;
-        Tally tally;
-        EXPECT_TRUE(run_explore(job, s, world, tally, never).complete);
-        if (world.is_root()) {
-            const Data got = read_result(dir / "memory.h5");
-            EXPECT_EQ(got.counts, want.counts) << "interleave from " << interleave << " ranks";
-            EXPECT_EQ(got.outcomes, want.outcomes) << "interleave from " << interleave << " ranks";
+    for (const int max_bounces : {1000, 70000}) {
+        for (const std::string compression : {"0", "1", "6"}) {
+            // 61 x 47 points in tiles of 16 x 12 (edge tiles on both axes).
+            const Job job = job_of("tile_points = 256\ncheckpoint_seconds = 0.01\ncompression = " + compression, max_bounces);
+            const Data want = direct(job);
+            const std::string name = "c" + compression + "-" + std::to_string(max_bounces);
+            Tally tally;
+            EXPECT_TRUE(run_explore(job, settings(dir / (name + ".h5")), world, tally, never).complete);
+            if (world.is_root()) {
+                const Data got = read_result(dir / (name + ".h5"));
+                EXPECT_EQ(got.counts, want.counts) << name;
+                EXPECT_EQ(got.outcomes, want.outcomes) << name;
+                const h5::Id file = h5::open_file(dir / (name + ".h5"), false);
+                const h5::Storage st = h5::dataset_storage(h5::open_dataset(file, layout::wall_bounces));
+                const Extent tile = default_tiling(job, world.size()).tile_shape();
+                EXPECT_EQ(st.chunk, std::vector<hsize_t>(tile.begin(), tile.end())) << name;
+                EXPECT_EQ(st.deflate_level, compression == "0" ? -1 : std::stoi(compression)) << name;
+                EXPECT_TRUE(st.allocated) << name;
+            }
+            expect_stopped_and_resumed(job, settings(dir / (name + "-resumed.h5")), want, 5);
         }
     }
-    ExploreSettings s = settings(dir / "resumed.h5");
-    s.closing_memory_ranks = 1;
-    expect_stopped_and_resumed(job, s, want, 20);
+}
+
+// A run killed while rank 0 was making its partial file the result (io/placed_chunks.hpp)
+// leaves an undo log; the next run puts the partial file back as it was and finishes it.
+TEST(RunExplore, AFinishInterruptedHalfWayIsUndoneAndResumed)
+{
+    const SharedDir dir;
+    const Job job = job_of("tile_points = 256\ncheckpoint_seconds = 0.01");
+    const Data want = direct(job);
+    const fs::path out = dir / "undo.h5";
+    Tally first;
+    std::uint64_t polls = 0;
+    const StopRequested stop = [&] { return world.is_root() && first.start.tiles > 0 && ++polls > first.start.tiles / 2; };
+    EXPECT_TRUE(run_explore(job, settings(out), world, first, stop).interrupted);
+    const fs::path partial = layout::partial_path(out);
+    if (world.is_root()) {
+        // What an interrupted finish leaves: some of the file's bytes overwritten, more
+        // appended, the log of what was there.
+        const auto before = fs::file_size(partial);
+        {
+            PlacedChunks file(partial);
+            h5::write_attribute(file.file(), layout::kind_attribute, layout::kind_result);
+            h5::check(H5Ldelete(file.file(), "/progress", H5P_DEFAULT), "H5Ldelete");
+            file.close();
+        }
+        EXPECT_TRUE(fs::exists(PlacedChunks::undo_path(partial)));
+        EXPECT_THROW(ResultReader{partial}, FormatError);  // a result with no chunks: not readable
+        (void)before;
+    }
+    ExploreSettings s = settings(out, true);
+    Tally second;
+    EXPECT_TRUE(run_explore(job, s, world, second, never).complete);
+    if (world.is_root()) {
+        EXPECT_GT(second.start.tiles_done, 0u);
+        const Data got = read_result(out);
+        EXPECT_EQ(got.counts, want.counts);
+        EXPECT_EQ(got.outcomes, want.outcomes);
+        EXPECT_FALSE(fs::exists(PlacedChunks::undo_path(partial)));
+    }
 }
 
 TEST(RunExplore, RefinementDoesNotDependOnTheRankCount)

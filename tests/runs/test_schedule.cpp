@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <map>
 #include <set>
@@ -31,7 +32,8 @@ std::uint64_t checksum_of(std::uint64_t tile) { return tile * 0x9E3779B97F4A7C15
 
 // Stands for counting and writing: a tile takes `tile_seconds` of sleep (so that
 // oversubscribed ranks do not compete for the cores), calling `serve` four times; the
-// "writer" keeps tiles until flush() writes them.
+// "writer" keeps tiles until flush() writes them, and sends with their reports a payload
+// naming them (an odd number of bytes: not a whole word), as compressed tiles travel.
 class FakeWork final : public TileWork {
 public:
     explicit FakeWork(double tile_seconds) : tile_seconds_(tile_seconds) {}
@@ -48,17 +50,25 @@ public:
         buffered_.push_back(tile);
     }
 
-    std::vector<TileReport> flush() override
+    Flushed flush() override
     {
         const double t = seconds();
-        std::vector<TileReport> out;
+        Flushed out;
         for (const std::uint64_t tile : buffered_) {
-            out.push_back({tile, checksum_of(tile)});
+            out.reports.push_back({tile, checksum_of(tile)});
             written.push_back(tile);
             written_at.push_back(t);
         }
+        out.payload = payload_of(out.reports);
         buffered_.clear();
         return out;
+    }
+
+    static std::vector<std::byte> payload_of(std::span<const TileReport> reports)
+    {
+        std::vector<std::byte> p(8 * reports.size() + 3, std::byte{0x5a});
+        for (std::size_t i = 0; i < reports.size(); ++i) std::memcpy(p.data() + 8 * i, &reports[i].tile, 8);
+        return p;
     }
 
     std::vector<std::uint64_t> computed;
@@ -121,6 +131,7 @@ struct Outcome {
     double returned_at = 0;
     // Rank 0 only:
     std::vector<Reported> reported;
+    std::uint64_t bad_payloads = 0;  // groups whose payload did not name their tiles
     std::vector<std::vector<std::uint64_t>> computed, written, handed_out;
     std::vector<std::vector<double>> started, ended, written_at, returned;
     std::vector<std::vector<std::uint64_t>> stats;  // per rank: tiles, blocks, flushes, computed (0/1), two_level, given_back
@@ -131,9 +142,11 @@ Outcome run_once(const std::vector<std::uint64_t>& pending, const ScheduleSettin
 {
     FakeWork work(tile_seconds);
     Outcome out;
-    const TilesDone done = [&](std::span<const TileReport> tiles, int rank) {
+    const TilesDone done = [&](std::span<const TileReport> tiles, int rank, std::span<const std::byte> payload) {
         const double t = seconds();
         for (const TileReport& r : tiles) out.reported.push_back({r, rank, t});
+        const std::vector<std::byte> sent = FakeWork::payload_of(tiles);
+        if (!std::equal(sent.begin(), sent.end(), payload.begin(), payload.end())) ++out.bad_payloads;
     };
     const StopRequested stop = [&] { return stop_when && stop_when(work); };
     out.result = run_schedule(world, pending, work, done, stop, settings);
@@ -152,7 +165,7 @@ Outcome run_once(const std::vector<std::uint64_t>& pending, const ScheduleSettin
 }
 
 // On rank 0: each reported tile was computed and written by the rank named, before it was
-// reported, with its checksum; no tile twice; every computed tile reported (all of them
+// reported, with its checksum and payload; no tile twice; every computed tile reported (all of them
 // are written by the end, stopped or not); every pending tile when not interrupted.
 void expect_reported_once(const Outcome& r, const std::vector<std::uint64_t>& pending)
 {
@@ -176,6 +189,7 @@ void expect_reported_once(const Outcome& r, const std::vector<std::uint64_t>& pe
         EXPECT_LE(w->second.second, x.at) << "tile " << t << " reported before it was written";
     }
     EXPECT_EQ(reported, computed) << "every computed tile is written and reported by the end";
+    EXPECT_EQ(r.bad_payloads, 0u) << "payloads reach rank 0 whole, with the reports they came with";
     const std::set<std::uint64_t> all(pending.begin(), pending.end());
     for (const std::uint64_t t : computed) EXPECT_TRUE(all.count(t)) << "tile " << t << " was not pending";
     if (!r.result.interrupted) {
@@ -408,7 +422,7 @@ TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
             if (heavy) ++heavy_tiles;
             done_.push_back({tile, checksum_of(tile)});
         }
-        std::vector<TileReport> flush() override { return std::exchange(done_, {}); }
+        Flushed flush() override { return {std::exchange(done_, {}), {}}; }
         std::uint64_t heavy_tiles = 0;
 
     private:
@@ -416,7 +430,7 @@ TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
         std::vector<TileReport> done_;
     } work(n);
     std::uint64_t reported = 0;
-    const TilesDone done = [&](std::span<const TileReport> tiles, int) { reported += tiles.size(); };
+    const TilesDone done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte>) { reported += tiles.size(); };
     const ScheduleResult r = run_schedule(world, pending, work, done, [] { return false; }, settings_of(GetParam()));
     EXPECT_FALSE(r.interrupted);
     if (world.is_root()) {
