@@ -42,12 +42,14 @@ ChunkEncoder::ChunkEncoder(int level)
 std::size_t ChunkEncoder::deflate(std::span<const std::uint8_t> in, std::vector<std::byte>& out)
 {
     auto* c = static_cast<libdeflate_compressor*>(compressor_.get());
-    const std::size_t at = out.size();
-    out.resize(at + libdeflate_zlib_compress_bound(c, in.size()));
-    const std::size_t n = libdeflate_zlib_compress(c, in.data(), in.size(), out.data() + at, out.size() - at);
+    // Into a buffer kept between chunks, then only the stream's bytes onto `out`: growing
+    // `out` by the bound would zero it for every chunk (about 3 % of counting's time).
+    const std::size_t bound = libdeflate_zlib_compress_bound(c, in.size());
+    if (stream_.size() < bound) stream_.resize(bound);
+    const std::size_t n = libdeflate_zlib_compress(c, in.data(), in.size(), stream_.data(), stream_.size());
     // The bound is libdeflate's own: a chunk always fits it.
     if (n == 0) throw std::logic_error("libdeflate_zlib_compress: the output did not fit its own bound");
-    out.resize(at + n);
+    out.insert(out.end(), stream_.begin(), stream_.begin() + static_cast<std::ptrdiff_t>(n));
     return n;
 }
 

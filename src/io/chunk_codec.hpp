@@ -49,6 +49,7 @@ private:
     };
     std::unique_ptr<void, Free> compressor_;  // a libdeflate_compressor
     std::vector<std::uint8_t> shuffled_;
+    std::vector<std::byte> stream_;
     // (value, points, bytes per value) -> stored chunk; a few entries at most in practice,
     // bounded below.
     std::map<std::tuple<std::uint32_t, std::size_t, std::size_t>, std::vector<std::byte>> constants_;

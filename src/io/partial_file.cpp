@@ -457,12 +457,14 @@ void Journal::record(std::span<const AppendedTile> tiles)
     }
 }
 
-bool Journal::due() const { return dirty_end_ > dirty_begin_ && std::chrono::steady_clock::now() - last_ >= interval_; }
+bool Journal::due() const { return std::chrono::steady_clock::now() - last_ >= interval_; }
 
-void Journal::checkpoint(bool now)
+bool Journal::checkpoint(bool now)
 {
     const auto t = std::chrono::steady_clock::now();
-    if (dirty_end_ <= dirty_begin_ || (!now && t - last_ < interval_)) return;
+    if (!now && t - last_ < interval_) return false;
+    last_ = t;
+    if (dirty_end_ <= dirty_begin_) return false;
     const PartialLayout& l = file_.layout();
     const std::uint64_t n = dirty_end_ - dirty_begin_;
     try {
@@ -477,9 +479,9 @@ void Journal::checkpoint(bool now)
         throw h5::Error(fmt::format("recording tiles {} to {} done in {} failed ({}){}", dirty_begin_, dirty_end_ - 1,
                                     file_.path().string(), e.what(), free_space_note(file_.path())));
     }
-    last_ = t;
     dirty_begin_ = journal_.done.size();
     dirty_end_ = 0;
+    return true;
 }
 
 }  // namespace superball

@@ -218,9 +218,10 @@ public:
 
     void record(std::span<const TileReport> tiles);    // uncompressed files
     void record(std::span<const AppendedTile> tiles);  // compressed files
-    // Writes what changed since the last write, if `interval` has passed or `now` is true.
-    void checkpoint(bool now);
-    // Something changed and `interval` has passed since the last write.
+    // Writes what changed since the last write, if `interval` has passed or `now` is true;
+    // true if it wrote.
+    bool checkpoint(bool now);
+    // `interval` has passed since the last write.
     bool due() const;
     std::uint64_t tiles_done() const { return tiles_done_; }
     const TileJournal& tiles() const { return journal_; }

@@ -104,8 +104,10 @@ Extent default_tile_shape(const Extent& shape, std::uint64_t target_points)
 
 std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks)
 {
-    const std::uint64_t per_rank_share = grid_points / (16 * static_cast<std::uint64_t>(std::max(ranks, 1)));
-    return std::clamp<std::uint64_t>(per_rank_share, 1024, std::uint64_t{1} << 18);
+    const auto r = static_cast<std::uint64_t>(std::max(ranks, 1));
+    // At least 4 tiles per rank, and tiles of 2^17 points where that leaves so many.
+    const std::uint64_t floor = std::clamp<std::uint64_t>(grid_points / (4 * r), 1024, std::uint64_t{1} << 17);
+    return std::clamp<std::uint64_t>(grid_points / (16 * r), floor, std::uint64_t{1} << 18);
 }
 
 std::vector<std::uint64_t> handout_order(const std::vector<std::uint64_t>& pending, std::uint64_t granule, bool interleave)

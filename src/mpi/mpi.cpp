@@ -54,14 +54,12 @@ std::vector<McaSetting> single_node_mca(const Getenv& getenv, std::string_view u
             if (is_set(getenv, launcher)) return {};
         }
     }
-    // Each setting with the parameters whose value, set by the user, means it is left
-    // alone: choosing an I/O component (io = romio321) makes the choice of OMPIO's
-    // collective writer moot.
+    // Each setting with the parameters whose value, set by the user, means it is left alone.
     struct Wanted {
         McaSetting setting;
         std::vector<std::string> unless;
     };
-    std::vector<Wanted> wanted{{{"pml", "ob1"}, {"pml"}}, {{"fcoll", "two_phase"}, {"fcoll", "io"}}};
+    std::vector<Wanted> wanted{{{"pml", "ob1"}, {"pml"}}};
     if (singleton) wanted.push_back({{"ess_singleton_isolated", "1"}, {"ess_singleton_isolated"}});
     std::vector<McaSetting> settings;
     for (Wanted& w : wanted) {
@@ -119,17 +117,6 @@ Environment::PrivateDirectory::~PrivateDirectory()
     std::filesystem::remove_all(path_, ignored);
 }
 
-Info::Info() { check(MPI_Info_create(&info_), "MPI_Info_create"); }
-
-Info::~Info()
-{
-    if (info_ != MPI_INFO_NULL) MPI_Info_free(&info_);
-}
-
-void Info::set(const std::string& key, const std::string& value)
-{
-    check(MPI_Info_set(info_, key.c_str(), value.c_str()), "MPI_Info_set");
-}
 
 int Comm::rank() const
 {
@@ -196,30 +183,6 @@ std::vector<std::int32_t> Comm::max(const std::vector<std::int32_t>& v) const
 {
     std::vector<std::int32_t> out(v.size());
     check(MPI_Allreduce(v.data(), out.data(), static_cast<int>(v.size()), MPI_INT32_T, MPI_MAX, comm_), "MPI_Allreduce");
-    return out;
-}
-
-std::vector<std::byte> Comm::alltoallv(const std::vector<std::byte>& send, const std::vector<std::uint64_t>& send_counts,
-                                       const std::vector<std::uint64_t>& recv_counts) const
-{
-    const auto n = static_cast<std::size_t>(size());
-    if (send_counts.size() != n || recv_counts.size() != n) throw std::logic_error("alltoallv: one count per rank");
-    // MPI counts and displacements are ints.
-    const auto to_ints = [](const std::vector<std::uint64_t>& counts, std::vector<int>& c, std::vector<int>& at) {
-        std::uint64_t total = 0;
-        for (std::size_t r = 0; r < counts.size(); ++r) {
-            c[r] = static_cast<int>(counts[r]);
-            at[r] = static_cast<int>(total);
-            total += counts[r];
-            if (total >= (std::uint64_t{1} << 31)) throw std::length_error("alltoallv: 2 GiB or more to one rank");
-        }
-        return total;
-    };
-    std::vector<int> sc(n), sd(n), rc(n), rd(n);
-    if (to_ints(send_counts, sc, sd) > send.size()) throw std::logic_error("alltoallv: counts beyond the data");
-    std::vector<std::byte> out(to_ints(recv_counts, rc, rd));
-    check(MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_BYTE, out.data(), rc.data(), rd.data(), MPI_BYTE, comm_),
-          "MPI_Alltoallv");
     return out;
 }
 

@@ -36,15 +36,7 @@ void check(int code, const char* what);
 //                                 ranks are all on this node (OMPI_COMM_WORLD_LOCAL_SIZE =
 //                                 OMPI_COMM_WORLD_SIZE);
 //   ess_singleton_isolated = 1    (no daemon: superball never spawns or connects to other
-//                                 processes) for a singleton;
-//   fcoll = two_phase             (OMPIO's two-phase collective writer, ROMIO's algorithm,
-//                                 for both: the closing pass of a run writes its small
-//                                 compressed chunks in collective writes, which OMPIO's
-//                                 default writer, vulcan, issues as 3.4 times as many
-//                                 write calls: 134 against 39 for the 8192^2 slice at -n 2;
-//                                 README, Running on a cluster). Left alone when the user
-//                                 chose fcoll or the I/O component (io = romio321, which
-//                                 Open MPI itself takes on Lustre).
+//                                 processes) for a singleton.
 // A parameter the user set is left alone: OMPI_MCA_<name> in the environment, even set to
 // nothing (also how `mpirun --mca NAME VALUE` reaches the ranks), or a line in
 // `user_params`, the text of ~/.openmpi/mca-params.conf; and nothing is set when other
@@ -89,20 +81,6 @@ private:
     std::optional<PrivateDirectory> session_base_;
 };
 
-// An MPI_Info object of hints (MPI-IO's, here), freed with the object.
-class Info {
-public:
-    Info();
-    ~Info();
-    Info(const Info&) = delete;
-    Info& operator=(const Info&) = delete;
-    void set(const std::string& key, const std::string& value);
-    MPI_Info get() const { return info_; }
-
-private:
-    MPI_Info info_ = MPI_INFO_NULL;
-};
-
 // A communicator borrowed from MPI (not freed here).
 class Comm {
 public:
@@ -127,11 +105,6 @@ public:
     double max(double x) const;
     // Element-wise largest value over ranks, on every rank.
     std::vector<std::int32_t> max(const std::vector<std::int32_t>& v) const;
-    // Every rank sends send_counts[r] bytes of `send` (in rank order) to rank r and receives
-    // recv_counts[r] bytes from rank r: what it received, in rank order (MPI_Alltoallv).
-    // Each count and each total below 2^31 bytes.
-    std::vector<std::byte> alltoallv(const std::vector<std::byte>& send, const std::vector<std::uint64_t>& send_counts,
-                                     const std::vector<std::uint64_t>& recv_counts) const;
     // Every rank's values concatenated in rank order, on rank 0 (empty elsewhere).
     std::vector<double> gather(const std::vector<double>& mine) const;
 

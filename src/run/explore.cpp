@@ -503,10 +503,11 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     // The journal written, and, for compressed tiles, every tile written so far recorded
     // first and then covered by the file's HDF5 end (PlacedChunks::cover): between two
     // checkpoints the partial file is a consistent HDF5 file holding every tile it records.
+    // (The write in progress is waited for: tiles are recorded once written, and a tile
+    // written a moment ago would otherwise wait a whole report period for the next call.)
     const auto checkpoint = [&] {
         if (appender) recorded(appender->flush());
-        record->checkpoint(true);
-        if (appender) PlacedChunks::cover(partial);
+        if (record->checkpoint(true) && appender) PlacedChunks::cover(partial);
     };
     const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
         if (appender) {

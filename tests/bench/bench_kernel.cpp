@@ -93,6 +93,32 @@ std::vector<CanonicalState<double>> long_lived()
     return starts;
 }
 
+// The 8192^2 benchmark slice counted by the scalar kernel as a plain C++ loop would: a row
+// of starts at a time, one core, nothing written. The yardstick of `explore -n 1` end to
+// end (tests/bench/run_benchmarks.py); its total of wall bounces must equal the result's.
+void BM_scalar_loop(benchmark::State& state)
+{
+    const std::size_t n = 8192;
+    std::vector<CanonicalState<double>> row(n);
+    std::vector<std::uint32_t> wb(n);
+    std::vector<std::uint8_t> oc(n);
+    std::uint64_t total = 0;
+    for (auto _ : state) {
+        total = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t k = 0; k < n; ++k) {
+                row[k] = {(static_cast<double>(i) + 0.5) / static_cast<double>(n), -1.0,
+                          -3.0 + (static_cast<double>(k) + 0.5) * 6.0 / static_cast<double>(n)};
+            }
+            scalar_kernel().count(Starts::of(row).view(), slice_model, 1000, wb, oc);
+            for (const std::uint32_t w : wb) total += w;
+        }
+        benchmark::DoNotOptimize(total);
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n * n));
+    state.counters["total_wall_bounces"] = static_cast<double>(total);
+}
+
 }  // namespace
 
 // The kernels by name: BM_count_slice/<kernel>/<n> for the scalar kernel and every
@@ -120,6 +146,7 @@ int main(int argc, char** argv)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }
+    benchmark::RegisterBenchmark("BM_scalar_loop/8192", BM_scalar_loop)->Unit(benchmark::kMillisecond)->UseRealTime();
     benchmark::AddCustomContext("superball", kernel_report());
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

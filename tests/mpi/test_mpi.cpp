@@ -26,21 +26,20 @@ Getenv environment(const std::map<std::string, std::string>& vars)
 
 const McaSetting ob1{"pml", "ob1"};
 const McaSetting isolated{"ess_singleton_isolated", "1"};
-const McaSetting two_phase{"fcoll", "two_phase"};
 const std::map<std::string, std::string> mpirun_one_node{
     {"OMPI_COMM_WORLD_SIZE", "2"}, {"OMPI_COMM_WORLD_LOCAL_SIZE", "2"}, {"PMIX_RANK", "1"}};
 
 TEST(SingleNodeMca, SingletonGetsOb1WithoutADaemon)
 {
-    EXPECT_EQ(single_node_mca(environment({{"HOME", "/root"}, {"PATH", "/usr/bin"}}), ""), (Settings{ob1, two_phase, isolated}));
+    EXPECT_EQ(single_node_mca(environment({{"HOME", "/root"}, {"PATH", "/usr/bin"}}), ""), (Settings{ob1, isolated}));
     // Inside a Slurm allocation but started without srun: still a singleton.
     EXPECT_EQ(single_node_mca(environment({{"SLURM_JOB_ID", "12"}, {"SLURM_NNODES", "4"}}), ""),
-              (Settings{ob1, two_phase, isolated}));
+              (Settings{ob1, isolated}));
 }
 
 TEST(SingleNodeMca, MpirunOnOneNodeGetsOb1)
 {
-    EXPECT_EQ(single_node_mca(environment(mpirun_one_node), ""), (Settings{ob1, two_phase}));
+    EXPECT_EQ(single_node_mca(environment(mpirun_one_node), ""), Settings{ob1});
 }
 
 TEST(SingleNodeMca, SeveralNodesKeepOpenMpisChoice)
@@ -63,31 +62,26 @@ TEST(SingleNodeMca, OtherLaunchersKeepOpenMpisChoice)
 TEST(SingleNodeMca, TheUsersChoiceIsNeverReplaced)
 {
     for (const char* value : {"ucx", "cm", "^ucx", ""}) {
-        EXPECT_EQ(single_node_mca(environment({{"OMPI_MCA_pml", value}}), ""), (Settings{two_phase, isolated})) << value;
+        EXPECT_EQ(single_node_mca(environment({{"OMPI_MCA_pml", value}}), ""), Settings{isolated}) << value;
         auto vars = mpirun_one_node;
         vars["OMPI_MCA_pml"] = value;
-        EXPECT_EQ(single_node_mca(environment(vars), ""), Settings{two_phase}) << value;
+        EXPECT_EQ(single_node_mca(environment(vars), ""), Settings{}) << value;
     }
-    EXPECT_EQ(single_node_mca(environment({{"OMPI_MCA_ess_singleton_isolated", "0"}}), ""), (Settings{ob1, two_phase}));
+    EXPECT_EQ(single_node_mca(environment({{"OMPI_MCA_ess_singleton_isolated", "0"}}), ""), Settings{ob1});
     EXPECT_EQ(single_node_mca(environment({{"OMPI_MCA_mca_base_param_files", "/etc/site.conf"}}), ""), Settings{});
     // ~/.openmpi/mca-params.conf
     EXPECT_EQ(single_node_mca(environment({}), "# site defaults\nbtl = self,vader,tcp\n  pml\t= ucx  # fast\n"),
-              (Settings{two_phase, isolated}));
+              Settings{isolated});
     EXPECT_EQ(single_node_mca(environment({}), "btl = self,vader\n# pml = ucx\npml_ucx_verbose = 1\n"),
-              (Settings{ob1, two_phase, isolated}));
+              (Settings{ob1, isolated}));
 }
 
-TEST(SingleNodeMca, TheUsersChoiceOfCollectiveWriterOrIoComponentIsKept)
+TEST(SingleNodeMca, NoChoiceOfTheFileLayersIsMade)
 {
-    // The collective writer (fcoll), or the I/O component (io), which makes it moot.
-    for (const char* name : {"OMPI_MCA_fcoll", "OMPI_MCA_io"}) {
-        auto vars = mpirun_one_node;
-        vars.emplace(name, "x");
-        EXPECT_EQ(single_node_mca(environment(vars), ""), Settings{ob1}) << name;
-    }
+    // superball writes its files with POSIX calls and serial HDF5 (io/partial_file.hpp):
+    // MPI-IO's components are the user's business.
     EXPECT_EQ(single_node_mca(environment(mpirun_one_node), "io = romio321\n"), Settings{ob1});
     EXPECT_EQ(single_node_mca(environment(mpirun_one_node), "fcoll = vulcan\n"), Settings{ob1});
-    EXPECT_EQ(single_node_mca(environment(mpirun_one_node), "fcoll_vulcan_priority = 10\n"), (Settings{ob1, two_phase}));
 }
 
 }  // namespace
