@@ -81,7 +81,7 @@ void TerminalProgress::computed(double seconds)
 void TerminalProgress::finishing()
 {
     if (quiet_) return;
-    fmt::print(out_, "writing the result: compressing and writing every tile from the partial file\n");
+    fmt::print(out_, "finishing the result: the partial file's tiles indexed where they lie, then renamed\n");
     std::fflush(out_);
 }
 

@@ -32,7 +32,7 @@ public:
     virtual void tiles_done(std::uint64_t /*tiles*/, std::uint64_t /*points*/) {}
     // The compute phase is over (before the result is written).
     virtual void computed(double /*seconds*/) {}
-    // Every tile is done: the result is being written from the partial file.
+    // Every tile is done: the partial file is being made the result.
     virtual void finishing() {}
 };
 

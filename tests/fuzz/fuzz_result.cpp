@@ -31,9 +31,11 @@
 #include <string>
 #include <vector>
 
+#include "io/chunk_codec.hpp"
 #include "io/hdf5.hpp"
 #include "io/layout.hpp"
 #include "io/partial_file.hpp"
+#include "io/placed_chunks.hpp"
 #include "io/result_metadata.hpp"
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
@@ -105,8 +107,8 @@ void write_box(hid_t d, hid_t memory_type, const Box& box, const void* values)
     h5::check(H5Dwrite(d, memory_type, memory, space, H5P_DEFAULT, values), "H5Dwrite");
 }
 
-// A complete result as io/final_result.cpp lays it out (serially): coordinate variables,
-// attributes, the data in compressed chunks.
+// A complete result as io/final_result.cpp leaves it (written here through HDF5's filters):
+// coordinate variables, attributes, the data in compressed chunks.
 void write_result(const fs::path& path, const char* text)
 {
     const Job job = parse_job(text, "template");
@@ -135,47 +137,89 @@ void write_result(const fs::path& path, const char* text)
     write_box(outcomes, H5T_NATIVE_UINT8, all, o.data());
 }
 
-// The partial file of an interrupted run (io/partial_file.cpp), every other tile done.
-void write_partial(const fs::path& path, const char* text)
+// The partial file of an interrupted run (io/partial_file.cpp), every other tile done:
+// uncompressed (the tiles in their chunks), or compressed (the tiles' stored chunks past the
+// HDF5 objects, where /progress/tile_stored says).
+void write_partial(const fs::path& path, const char* text, bool compressed)
 {
-    const Job job = parse_job(text, "template");
+    Job job = parse_job(text, "template");
+    job.compression = compressed ? 4 : 0;
     const Grid grid(job);
     const Tiling tiling(grid.shape(), default_tile_shape(grid.shape(), 48));
-    create_partial(path, job, grid, tiling, 1);
-    const h5::Id file = h5::open_file(path, true);
-    const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
-    const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
+    const PartialLayout layout = create_partial(path, job, grid, tiling, 1);
     std::vector<std::uint8_t> done(tiling.tiles(), 0);
     std::vector<std::uint64_t> sums(tiling.tiles(), 0);
-    for (std::uint64_t t = 0; t < tiling.tiles(); t += 2) {
+    std::vector<std::uint64_t> stored(3 * tiling.tiles(), 0);
+    const auto values_of = [&](std::uint64_t t, std::vector<std::uint32_t>& c, std::vector<std::uint8_t>& o) {
         const Box box = tiling.box(t);
-        std::vector<std::uint32_t> c(box.points());
-        std::vector<std::uint8_t> o(box.points());
+        c.resize(box.points());
+        o.resize(box.points());
         for (std::uint64_t i = 0; i < c.size(); ++i) valid_values(t * 1000 + i, job.max_bounces, c[i], o[i]);
-        write_box(counts, H5T_NATIVE_UINT32, box, c.data());
-        write_box(outcomes, H5T_NATIVE_UINT8, box, o.data());
-        done[t] = 1;
-    }
-    h5::check(H5Fflush(file, H5F_SCOPE_GLOBAL), "H5Fflush");
-    for (std::uint64_t t = 0; t < tiling.tiles(); t += 2) {
-        const std::vector<hsize_t> origin = to_hsize(tiling.box(t).start);
-        std::vector<std::byte> chunks[2];
-        for (int k = 0; k < 2; ++k) {
-            const hid_t d = k == 0 ? counts.get() : outcomes.get();
-            hsize_t bytes = 0;
-            h5::check(H5Dget_chunk_storage_size(d, origin.data(), &bytes), "H5Dget_chunk_storage_size");
-            chunks[k].resize(bytes);
-            std::uint32_t filters = 0;
-            h5::check(H5Dread_chunk(d, H5P_DEFAULT, origin.data(), &filters, chunks[k].data()), "H5Dread_chunk");
+    };
+    if (compressed) {
+        ChunkEncoder encoder(4);
+        std::vector<std::byte> bytes;
+        std::uint64_t at = fs::file_size(path);
+        std::vector<std::uint32_t> c, cc;
+        std::vector<std::uint8_t> o, oc;
+        for (std::uint64_t t = 0; t < tiling.tiles(); t += 2) {
+            values_of(t, c, o);
+            const std::size_t from = bytes.size();
+            const std::size_t nc = encoder.counts(in_chunk_layout<std::uint32_t>(tiling, t, c, cc), layout.count_bytes, bytes);
+            const std::size_t no = encoder.outcomes(in_chunk_layout<std::uint8_t>(tiling, t, o, oc), bytes);
+            const std::span<const std::byte> tile(bytes.data() + from, nc + no);
+            sums[t] = tile_checksum(t, tile.first(nc), tile.subspan(nc));
+            stored[3 * t] = at + from;
+            stored[3 * t + 1] = nc;
+            stored[3 * t + 2] = no;
+            done[t] = 1;
         }
-        sums[t] = tile_checksum(t, chunks[0], chunks[1]);
+        std::ofstream(path, std::ios::binary | std::ios::app).write(reinterpret_cast<const char*>(bytes.data()),
+                                                                    static_cast<std::streamsize>(bytes.size()));
+        (void)at;
     }
-    h5::check(H5Dwrite(h5::open_dataset(file, layout::tile_done), H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                       done.data()),
-              "write tile_done");
-    h5::check(H5Dwrite(h5::open_dataset(file, layout::tile_checksum), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                       sums.data()),
-              "write tile_checksum");
+    {
+        PlacedChunks placed(path);  // keeps the bytes appended past HDF5's end
+        const hid_t file = placed.file();
+        if (!compressed) {
+            const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
+            const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
+            std::vector<std::uint32_t> c;
+            std::vector<std::uint8_t> o;
+            for (std::uint64_t t = 0; t < tiling.tiles(); t += 2) {
+                values_of(t, c, o);
+                write_box(counts, H5T_NATIVE_UINT32, tiling.box(t), c.data());
+                write_box(outcomes, H5T_NATIVE_UINT8, tiling.box(t), o.data());
+                done[t] = 1;
+            }
+            h5::check(H5Fflush(file, H5F_SCOPE_GLOBAL), "H5Fflush");
+            for (std::uint64_t t = 0; t < tiling.tiles(); t += 2) {
+                const std::vector<hsize_t> origin = to_hsize(tiling.box(t).start);
+                std::vector<std::byte> chunks[2];
+                for (int k = 0; k < 2; ++k) {
+                    const hid_t d = k == 0 ? counts.get() : outcomes.get();
+                    hsize_t bytes = 0;
+                    h5::check(H5Dget_chunk_storage_size(d, origin.data(), &bytes), "H5Dget_chunk_storage_size");
+                    chunks[k].resize(bytes);
+                    std::uint32_t filters = 0;
+                    h5::check(H5Dread_chunk(d, H5P_DEFAULT, origin.data(), &filters, chunks[k].data()), "H5Dread_chunk");
+                }
+                sums[t] = tile_checksum(t, chunks[0], chunks[1]);
+            }
+        } else {
+            h5::check(H5Dwrite(h5::open_dataset(file, layout::tile_stored), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                               stored.data()),
+                      "write tile_stored");
+        }
+        h5::check(H5Dwrite(h5::open_dataset(file, layout::tile_done), H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                           done.data()),
+                  "write tile_done");
+        h5::check(H5Dwrite(h5::open_dataset(file, layout::tile_checksum), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                           sums.data()),
+                  "write tile_checksum");
+        placed.close();
+    }
+    PlacedChunks::discard_undo(path);
 }
 
 fs::path scratch_directory()
@@ -202,10 +246,11 @@ struct Templates {
             fs::remove(layout::partial_path(t));
         };
         write_result(t, job_2d), keep();
-        write_partial(t, job_2d), keep();
+        write_partial(t, job_2d, true), keep();
         write_result(t, job_3d), keep();
-        write_partial(t, job_1d), keep();
-        write_partial(t, job_3d), keep();
+        write_partial(t, job_1d, false), keep();
+        write_partial(t, job_3d, true), keep();
+        write_partial(t, job_2d, false), keep();
     }
     ~Templates()
     {
@@ -244,7 +289,7 @@ const std::array<const char*, 8> objects = {"/",     "/wall_bounces",       "/ou
                                              "/xi",   "/W",                  "/U",
                                              "/progress/tile_done", "/progress/tile_checksum"};
 // The objects of the templates beyond those names: the other coordinate variables.
-const std::array<const char*, 4> more_objects = {"/e", "/x", "/u", "/progress"};
+const std::array<const char*, 5> more_objects = {"/e", "/x", "/u", "/progress", "/progress/tile_stored"};
 
 std::string object_name(Input& in)
 {
@@ -457,6 +502,23 @@ std::vector<Region> raw_regions(hid_t file)
                 }
             } catch (const h5::Error&) {
             }
+        }
+        // A compressed partial file's stored tiles, past its HDF5 objects.
+        try {
+            if (h5::object_type(file, layout::tile_stored) == h5::ObjectType::dataset) {
+                const h5::Id d = h5::open_dataset(file, layout::tile_stored);
+                const h5::Shape st = h5::dataset_shape_of(d);
+                if (st.dims.size() == 2 && st.dims[1] == 3 && st.bytes == 8 && st.dims[0] < 4096) {
+                    std::vector<std::uint64_t> w(3 * st.dims[0]);
+                    h5::check(H5Dread(d, H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, w.data()), "read");
+                    for (std::size_t t = 0; t < st.dims[0]; ++t) {
+                        if (w[3 * t + 1] + w[3 * t + 2] > 0 && w[3 * t + 1] + w[3 * t + 2] < (1u << 20)) {
+                            regions.push_back({w[3 * t], w[3 * t + 1] + w[3 * t + 2]});
+                        }
+                    }
+                }
+            }
+        } catch (const h5::Error&) {
         }
     }
     return regions;
