@@ -52,10 +52,11 @@ void print_summary(const Job& job, const RunSummary& r, const KernelVariant& ker
     fmt::print(stderr, "peak memory per rank: {:.1f} MiB (largest rank)\n", r.peak_rss_mib);
     fmt::print(stderr, "counting kernel: {}\n", describe(kernel));
     if (r.complete && r.raw_bytes > 0) {
-        fmt::print(stderr, "result: {} ({:.3g} MB, {:.2f}% of the {:.3g} MB of raw data; written in {:.2f} s)\n",
+        fmt::print(stderr, "result: {} ({:.3g} MB, {:.2f}% of the {:.3g} MB of raw data; finished {:.3g} ms after the last "
+                           "tile was counted)\n",
                    r.output.string(), static_cast<double>(r.result_bytes) / 1e6,
                    100.0 * static_cast<double>(r.result_bytes) / static_cast<double>(r.raw_bytes),
-                   static_cast<double>(r.raw_bytes) / 1e6, r.finish_seconds);
+                   static_cast<double>(r.raw_bytes) / 1e6, 1e3 * r.finish_seconds);
     } else if (r.complete) {
         fmt::print(stderr, "result: {}\n", r.output.string());
     }

@@ -28,8 +28,8 @@ std::uint64_t size_of(const fs::path& p)
 
 }  // namespace
 
-FinishReport finish_result(const fs::path& partial, const fs::path& output, const Tiling& tiling, const PartialLayout& layout,
-                           const TileJournal& journal, const RunFigures& run)
+FinishReport finish_result(const fs::path& partial, const fs::path& output, const ResultInfo& info, const Tiling& tiling,
+                           const PartialLayout& layout, const TileJournal& journal, const RunFigures& run)
 {
     const auto started = std::chrono::steady_clock::now();
     for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
@@ -64,8 +64,8 @@ FinishReport finish_result(const fs::path& partial, const fs::path& output, cons
     report.raw_bytes = tiling.points() * (layout.count_bytes + 1);
     // The result is complete whatever happens to its sidecar: a failure here is a note.
     try {
-        const fs::path xmf = write_xdmf(output);
-        report.sidecar_note = xmf.empty() ? "no XDMF sidecar: " + xdmf_unsupported(output) : "sidecar: " + xmf.string();
+        const fs::path xmf = write_xdmf(output, info);
+        report.sidecar_note = xmf.empty() ? "no XDMF sidecar: " + xdmf_unsupported(output, info) : "sidecar: " + xmf.string();
     } catch (const std::exception& e) {
         report.sidecar_note = std::string("no XDMF sidecar: writing it failed (") + e.what() + ")";
     }

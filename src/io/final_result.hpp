@@ -15,6 +15,7 @@
 #include "job/tiles.hpp"
 #include "partial_file.hpp"
 #include "result_metadata.hpp"
+#include "result_reader.hpp"
 
 namespace superball {
 
@@ -26,10 +27,11 @@ struct FinishReport {
 };
 
 // Makes the partial file `partial` (of layout `layout`, with every tile done as `journal`
-// records) the result `output`, with the run's figures. Throws h5::Error or
+// records) the result `output`, with the run's figures; `info` describes it (for its
+// sidecar: the file is not read back). Throws h5::Error or
 // std::runtime_error naming the file on failure; the partial file is then as it was
 // (PlacedChunks's undo log), and a resume finishes it.
-FinishReport finish_result(const std::filesystem::path& partial, const std::filesystem::path& output, const Tiling& tiling,
-                           const PartialLayout& layout, const TileJournal& journal, const RunFigures& run);
+FinishReport finish_result(const std::filesystem::path& partial, const std::filesystem::path& output, const ResultInfo& info,
+                           const Tiling& tiling, const PartialLayout& layout, const TileJournal& journal, const RunFigures& run);
 
 }  // namespace superball

@@ -34,11 +34,15 @@ namespace {
 // for one (nor replaced: is_undo_log).
 constexpr char undo_magic[8] = {'S', 'B', 'U', 'N', 'D', 'O', '0', '1'};
 
-bool write_all(int fd, const void* data, std::size_t size, off_t at)
+// Moves exactly `size` bytes at `at` with pread or pwrite (retrying short and interrupted
+// calls); false on an error or at the end of the file. (The driver's callbacks report
+// failure to HDF5 by their return value and cannot throw, so PosixFile's throwing calls
+// do not serve here.)
+template <class Byte, class Call>
+bool transfer(Call call, int fd, Byte* b, std::size_t size, off_t at)
 {
-    const auto* b = static_cast<const unsigned char*>(data);
     while (size > 0) {
-        const ssize_t n = ::pwrite(fd, b, size, at);
+        const ssize_t n = call(fd, b, size, at);
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) return false;
         b += n;
@@ -48,18 +52,14 @@ bool write_all(int fd, const void* data, std::size_t size, off_t at)
     return true;
 }
 
+bool write_all(int fd, const void* data, std::size_t size, off_t at)
+{
+    return transfer(::pwrite, fd, static_cast<const unsigned char*>(data), size, at);
+}
+
 bool read_all(int fd, void* data, std::size_t size, off_t at)
 {
-    auto* b = static_cast<unsigned char*>(data);
-    while (size > 0) {
-        const ssize_t n = ::pread(fd, b, size, at);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        b += n;
-        at += n;
-        size -= static_cast<std::size_t>(n);
-    }
-    return true;
+    return transfer(::pread, fd, static_cast<unsigned char*>(data), size, at);
 }
 
 }  // namespace

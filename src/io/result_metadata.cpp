@@ -31,6 +31,25 @@ h5::Id create_doubles(hid_t file, const std::string& name, const std::vector<hsi
 
 hid_t count_type(const Job& job) { return job.max_bounces > 65535 ? H5T_STD_U32LE : H5T_STD_U16LE; }
 
+ResultInfo result_info(const Job& job, const Grid& grid)
+{
+    ResultInfo info;
+    info.kind = FileKind::result;
+    info.coordinate_system = name(job.coordinates);
+    for (const Coordinate* c : job.range_axes()) info.axis_names.push_back(c->name);
+    for (const Coordinate& c : job.grid) {
+        if (!c.is_range()) info.fixed.emplace_back(c.name, *c.fixed);
+    }
+    info.shape = grid.shape();
+    info.count_bytes = H5Tget_size(count_type(job));
+    info.job_toml = job.text;
+    info.job_fingerprint = fingerprint(job);
+    info.software_version = software_version;
+    info.max_bounces = job.max_bounces;
+    info.complete = true;
+    return info;
+}
+
 std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid, const char* kind, const RunFigures& run,
                                    bool write_samples)
 {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hdf5.hpp"
+#include "result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
 
@@ -34,5 +35,9 @@ void write_run_figures(hid_t file, const RunFigures& run);
 
 // The HDF5 type of the counts of a job: 16 bits unless max_bounces needs more.
 hid_t count_type(const Job& job);
+
+// What a result of `job` says about itself (the reader's ResultInfo) as write_metadata
+// writes it: for a writer that must describe its file without reading it back.
+ResultInfo result_info(const Job& job, const Grid& grid);
 
 }  // namespace superball

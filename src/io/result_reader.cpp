@@ -267,6 +267,8 @@ std::vector<std::pair<std::uint64_t, std::uint64_t>> raw_data_ranges(hid_t file)
                 if (const haddr_t at = H5Dget_offset(d); at != HADDR_UNDEF) ranges.emplace_back(at, H5Dget_storage_size(d));
                 continue;
             }
+            // (A result's compressed chunks are searched: HDF5 1.10 finds a chunk's address by
+            // walking its whole index, so listing them costs the square of their number.)
             if (st.filters != 0 || !st.allocated || s.elements() == 0) continue;
             std::uint64_t chunk_bytes = s.bytes, chunks = 1;
             std::vector<hsize_t> last(s.dims.size());

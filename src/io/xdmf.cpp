@@ -65,22 +65,19 @@ std::vector<MeshAxis> mesh_axes(const ResultInfo& info)
 
 }  // namespace
 
-std::string xdmf_unsupported(const std::filesystem::path& result)
+std::string xdmf_unsupported(const std::filesystem::path& result, const ResultInfo& info)
 {
     // XDMF names a dataset FILE:PATH with no way to escape a colon in FILE: the legacy
     // reader splits at the first and last colons, the Xdmf3 readers abort pvpython.
     if (result.filename().string().find(':') != std::string::npos) return "XDMF cannot name a file whose name has a colon";
     if (layout::sidecar_path(result) == result) return "the result's own name ends in .xmf";
-    const ResultReader reader(result);
-    if (mesh_axes(reader.info()).size() != 3) return "XDMF has no mesh for a result of more than 3 axes";
+    if (mesh_axes(info).size() != 3) return "XDMF has no mesh for a result of more than 3 axes";
     return "";
 }
 
-std::filesystem::path write_xdmf(const std::filesystem::path& result)
+std::filesystem::path write_xdmf(const std::filesystem::path& result, const ResultInfo& info)
 {
-    if (!xdmf_unsupported(result).empty()) return {};
-    const ResultReader reader(result);
-    const ResultInfo& info = reader.info();
+    if (!xdmf_unsupported(result, info).empty()) return {};
     const std::vector<MeshAxis> axes = mesh_axes(info);
     const std::filesystem::path out = layout::sidecar_path(result);
     const std::string h5 = xml_escape(result.filename().string());

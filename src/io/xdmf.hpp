@@ -15,17 +15,20 @@
 #include <string>
 #include <string_view>
 
+#include "result_reader.hpp"
+
 namespace superball {
 
-// Writes the sidecar of the complete result at `result` (layout::sidecar_path), naming the
-// result by its file name, so the pair keeps working when moved together and from any
-// working directory. Returns its path; empty, writing nothing, for a 4-D result (XDMF has
-// no 4-D mesh) and a result whose file name has a colon (XDMF cannot name it) or the
-// extension .xmf.
-std::filesystem::path write_xdmf(const std::filesystem::path& result);
+// Writes the sidecar of the complete result at `result` (layout::sidecar_path), of which
+// `info` describes the grid (the writer knows it: the file is not read again, which on a
+// cluster's result would be gigabytes), naming the result by its file name, so the pair
+// keeps working when moved together and from any working directory. Returns its path;
+// empty, writing nothing, for a 4-D result (XDMF has no 4-D mesh) and a result whose file
+// name has a colon (XDMF cannot name it) or the extension .xmf.
+std::filesystem::path write_xdmf(const std::filesystem::path& result, const ResultInfo& info);
 
 // Why `result` gets no sidecar ("" if it gets one).
-std::string xdmf_unsupported(const std::filesystem::path& result);
+std::string xdmf_unsupported(const std::filesystem::path& result, const ResultInfo& info);
 
 // `text` with the five XML special characters escaped.
 std::string xml_escape(std::string_view text);

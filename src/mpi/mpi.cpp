@@ -1,5 +1,10 @@
 #include "mpi.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -109,7 +114,45 @@ Environment::Environment()
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
 }
 
-Environment::~Environment() { MPI_Finalize(); }
+namespace {
+
+// Turns Nagle's algorithm off on this process's TCP connections to its own host. Open MPI
+// 4.1's PMIx client reaches the local server (mpirun or orted) over loopback TCP without
+// TCP_NODELAY, and MPI_Finalize sends it four small messages in a row: the later ones wait
+// for the acknowledgement of the first, which the server delays by Linux's 40 ms. Every
+// run under mpirun spent 45 ms in MPI_Finalize here, a third of a small job's time; with
+// this, 3 ms (a minimal MPI program under `mpirun -n 2`: 0.10 s in all against 0.06). Only
+// the option changes, never a byte of what is sent, and only on connections to this host;
+// the file descriptors are the process's own (no library state is touched).
+void no_delay_on_loopback()
+{
+    for (int fd = 0; fd < 1024; ++fd) {
+        int type = 0;
+        socklen_t size = sizeof type;
+        if (::getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &size) != 0 || type != SOCK_STREAM) continue;
+        sockaddr_storage peer{};
+        socklen_t peer_size = sizeof peer;
+        if (::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &peer_size) != 0) continue;
+        bool loopback = false;
+        if (peer.ss_family == AF_INET) {
+            loopback = (ntohl(reinterpret_cast<const sockaddr_in&>(peer).sin_addr.s_addr) >> 24) == 127;
+        } else if (peer.ss_family == AF_INET6) {
+            loopback = IN6_IS_ADDR_LOOPBACK(&reinterpret_cast<const sockaddr_in6&>(peer).sin6_addr);
+        }
+        const int one = 1;
+        if (loopback) ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    }
+}
+
+}  // namespace
+
+Environment::~Environment()
+{
+#ifdef OPEN_MPI
+    no_delay_on_loopback();
+#endif
+    MPI_Finalize();
+}
 
 Environment::PrivateDirectory::~PrivateDirectory()
 {

@@ -566,7 +566,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
                 record_partial_run(partial, seconds, comm.size());
             } else {
                 observer.finishing();
-                finish = finish_result(partial, plan.output, tiling, layout, record->tiles(),
+                finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, record->tiles(),
                                        {comm.size(), earlier_seconds + seconds, true});
             }
         } catch (const std::exception& e) {

@@ -135,12 +135,12 @@ class Explorer:
         points, rate = int(m.group(1)), float(m.group(2))
         peak = float(re.search(r"peak memory per rank: ([0-9.]+) MiB", r.stderr).group(1))
         # From the last tile counted to the result under its name, as explore reports it.
-        closing = re.search(r"written in ([0-9.]+) s\)", r.stderr)
+        closing = re.search(r"finished ([0-9.e+-]+) ms after the last tile", r.stderr)
         size = os.path.getsize(out) if os.path.exists(out) else 0
         if not keep:
             remove_outputs(out)
         return {"rate": rate, "compute": points / rate, "wall": wall, "peak": peak, "output": out, "stderr": r.stderr,
-                "closing": float(closing.group(1)) if closing else float("nan"), "size": size}
+                "closing": float(closing.group(1)) / 1e3 if closing else float("nan"), "size": size}
 
 
 def remove_outputs(out):
@@ -354,7 +354,7 @@ def main():
     for label, runs in closing:
         if runs:
             ratio_line(f"  {label}: closing / wall", [x["closing"] / x["wall"] for x in runs], "{:.1%}",
-                       f"{1e3 * median([x['closing'] for x in runs]):.1f} ms of {median([x['wall'] for x in runs]):.2f} s; "
+                       f"{1e3 * median([x['closing'] for x in runs]):.2g} ms of {median([x['wall'] for x in runs]):.2f} s; "
                        "target <= 5 %")
     tiles = 8192 * 8192 // 1024 - 8192 * 8192 // 262144
     ratio_line("\ncost per tile, whole process (trivial 8192^2 grid, -n 1, 1024- against 262144-point tiles)",

@@ -100,6 +100,21 @@ struct Fixture {
     }
 };
 
+// A fixture file with its chunks appended, not yet indexed.
+class PlacedChunksTest : public ::testing::Test {
+protected:
+    const TempDir dir;
+    const fs::path path = dir / "f.h5";
+    const Fixture fixture{path};
+    const std::vector<Fixture::Placed> placed = fixture.append_chunks(path);
+
+    void index_all(PlacedChunks& file) const
+    {
+        const h5::Id d = h5::open_dataset(file.file(), "/data");
+        for (const auto& p : placed) file.add(d, p.origin, p.address, p.bytes);
+    }
+};
+
 std::vector<std::uint32_t> read_all(const fs::path& path, std::size_t n)
 {
     const h5::Id file = h5::open_file(path, false);
@@ -109,21 +124,16 @@ std::vector<std::uint32_t> read_all(const fs::path& path, std::size_t n)
     return v;
 }
 
-TEST(PlacedChunks, HdfFiveReadsTheChunksWhereTheyLie)
+TEST_F(PlacedChunksTest, HdfFiveReadsTheChunksWhereTheyLie)
 {
-    const TempDir dir;
-    const fs::path path = dir / "f.h5";
-    const Fixture f(path);
-    const auto placed = f.append_chunks(path);
     const std::string before = bytes_of(path);
     {
         PlacedChunks file(path);
-        const h5::Id d = h5::open_dataset(file.file(), "/data");
-        for (const auto& p : placed) file.add(d, p.origin, p.address, p.bytes);
+        index_all(file);
         file.close();
     }
     PlacedChunks::discard_undo(path);
-    EXPECT_EQ(read_all(path, f.values.size()), f.values);
+    EXPECT_EQ(read_all(path, fixture.values.size()), fixture.values);
     // Not a byte of the chunks moved or was written again; the index came after them.
     const std::string after = bytes_of(path);
     const std::uint64_t first = placed.front().address, end = placed.back().address + placed.back().bytes;
@@ -134,12 +144,8 @@ TEST(PlacedChunks, HdfFiveReadsTheChunksWhereTheyLie)
     EXPECT_TRUE(h5::dataset_storage(h5::open_dataset(file, "/data")).allocated);
 }
 
-TEST(PlacedChunks, AChunkHdfFiveWouldPutElsewhereIsRefused)
+TEST_F(PlacedChunksTest, AChunkHdfFiveWouldPutElsewhereIsRefused)
 {
-    const TempDir dir;
-    const fs::path path = dir / "f.h5";
-    const Fixture f(path);
-    const auto placed = f.append_chunks(path);
     PlacedChunks file(path);
     const h5::Id d = h5::open_dataset(file.file(), "/data");
     file.add(d, placed[0].origin, placed[0].address, placed[0].bytes);
@@ -149,18 +155,13 @@ TEST(PlacedChunks, AChunkHdfFiveWouldPutElsewhereIsRefused)
     EXPECT_THROW(file.add(d, placed[0].origin, placed[1].address, placed[0].bytes), h5::Error);
 }
 
-TEST(PlacedChunks, TheUndoLogGivesBackTheFileAsItWas)
+TEST_F(PlacedChunksTest, TheUndoLogGivesBackTheFileAsItWas)
 {
-    const TempDir dir;
-    const fs::path path = dir / "f.h5";
-    const Fixture f(path);
-    const auto placed = f.append_chunks(path);
     const std::string before = bytes_of(path);
     EXPECT_FALSE(PlacedChunks::undo_interrupted_changes(path));  // no log: nothing to do
     {
         PlacedChunks file(path);
-        const h5::Id d = h5::open_dataset(file.file(), "/data");
-        for (const auto& p : placed) file.add(d, p.origin, p.address, p.bytes);
+        index_all(file);
         h5::write_attribute(file.file(), "note", "after, and longer than before");
         h5::check(H5Ldelete(file.file(), "/scratch", H5P_DEFAULT), "H5Ldelete");
         file.close();
@@ -175,12 +176,8 @@ TEST(PlacedChunks, TheUndoLogGivesBackTheFileAsItWas)
     EXPECT_FALSE(PlacedChunks::is_undo_log(PlacedChunks::undo_path(path)));
 }
 
-TEST(PlacedChunks, CoveredChunksSurviveAWriterThatCutsTheFileToItsEnd)
+TEST_F(PlacedChunksTest, CoveredChunksSurviveAWriterThatCutsTheFileToItsEnd)
 {
-    const TempDir dir;
-    const fs::path path = dir / "f.h5";
-    const Fixture f(path);
-    f.append_chunks(path);
     const auto size = fs::file_size(path);
     PlacedChunks::cover(path);
     EXPECT_FALSE(fs::exists(PlacedChunks::undo_path(path)));
