@@ -114,6 +114,7 @@ Environment::Environment()
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
 }
 
+#ifdef OPEN_MPI
 namespace {
 
 // Turns Nagle's algorithm off on this process's TCP connections to its own host. Open MPI
@@ -145,6 +146,7 @@ void no_delay_on_loopback()
 }
 
 }  // namespace
+#endif
 
 Environment::~Environment()
 {

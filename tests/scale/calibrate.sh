@@ -9,11 +9,10 @@
 #   NS_PER_ITERATION  compute time per wall bounce, from Garwin's ball (e = alpha = 1) on
 #                     a 64^3 volume at max_bounces 20000 at -n 1 (mean 1548 bounces a point,
 #                     7.7 % of the points capped: the load of jobs/cluster), less the two
-#                     terms above;
-#   COMPRESS_MBPS     the closing pass of `superball explore` at -n 1 (read back the raw
-#   COMPRESS_RATIO    data, shuffle + deflate, write the result) on jobs/full/volume.toml
-#                     (512^3): raw MB per second of "written in", and raw / result size
-#                     (simulate.sh takes each job's ratio from its low-resolution result).
+#                     terms above.
+#
+# Counting only: every job here runs with compression = 0. A tile's compression is charged
+# apart, at the speed and ratio scale_costs measures on each job's own sample.
 #
 # Each figure is the median of REPS (default 5) interleaved repetitions: this machine is
 # shared and a single run varies by +-25 %. Explore's own "computed in" time is used (the
@@ -35,7 +34,7 @@ mkdir -p "$work"
 job() {  # job NAME TILE_POINTS MODEL GRID MAX_BOUNCES
   {
     echo "[model]"; echo "$3"; echo "[grid]"; echo 'coordinates = "canonical"'; echo "$4"
-    echo "[run]"; echo "max_bounces = $5"; echo "output = \"$work/$1.h5\""
+    echo "[run]"; echo "max_bounces = $5"; echo "compression = 0"; echo "output = \"$work/$1.h5\""
     [[ $2 == 0 ]] || echo "tile_points = $2"
   } >"$work/$1.toml"
 }
@@ -52,21 +51,11 @@ for ((r = 0; r < reps; r++)); do
   for j in trivial_big trivial_small garwin; do times[$j]+="$(computed $j) "; done
   echo "calibrate: repetition $((r + 1)) of $reps: ${times[trivial_big]} / ${times[trivial_small]} / ${times[garwin]}" >&2
 done
-compress=""
-for ((r = 0; r < reps; r++)); do
-  # "result: PATH (R MB, P% of the RAW MB of raw data; written in T s)"
-  compress+="$(mpirun -n 1 "$superball" explore jobs/full/volume.toml -o "$work/volume.h5" --overwrite 2>&1 |
-    sed -n 's/^result: .*(\([0-9.]*\) MB, .* of the \([0-9.]*\) MB of raw data; written in \([0-9.]*\) s).*/\3:\2:\1/p') "
-done
-echo "calibrate: closing pass of jobs/full/volume.toml (s:raw MB:result MB): $compress" >&2
 garwin_tiles=$("$superball" explore "$work/garwin.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
-/usr/bin/python3 - "$work" "$garwin_tiles" "${times[trivial_big]}" "${times[trivial_small]}" "${times[garwin]}" "$compress" <<'EOF' >tests/scale/calibration.env
+/usr/bin/python3 - "$work" "$garwin_tiles" "${times[trivial_big]}" "${times[trivial_small]}" "${times[garwin]}" <<'EOF' >tests/scale/calibration.env
 import statistics, sys, h5py, numpy as np, datetime
 work, garwin_tiles = sys.argv[1], int(sys.argv[2])
 big, small, garwin = [[float(x) for x in a.split()] for a in sys.argv[3:6]]
-closing = [[float(x) for x in c.split(":")] for c in sys.argv[6].split()]
-compress = [c[0] for c in closing]
-raw, packed = closing[0][1] * 1e6, closing[0][2] * 1e6
 med = statistics.median
 points = 8192 * 8192
 tiles_big, tiles_small = points // 262144, points // 1024
@@ -79,12 +68,9 @@ with h5py.File(f"{work}/garwin.h5") as f:
 ns_per_iteration = (med(garwin) - n.size * ns_per_point * 1e-9 - garwin_tiles * us_per_tile * 1e-6) / n.sum() * 1e9
 print(f"# Cost model of tests/scale/simulate.sh, measured by tests/scale/calibrate.sh on {datetime.date.today()}")
 print(f"# (medians of {len(big)} runs: trivial grid {med(big):.3f} s with 262144-point tiles, {med(small):.3f} s with")
-print(f"# 1024-point tiles; Garwin's ball 64^3 {med(garwin):.3f} s for {n.sum():.4g} bounces; closing pass")
-print(f"# of jobs/full/volume.toml {med(compress):.3f} s for {raw / 1e6:.1f} MB raw, {packed / 1e6:.2f} MB compressed).")
+print(f"# 1024-point tiles; Garwin's ball 64^3 {med(garwin):.3f} s for {n.sum():.4g} bounces; all uncompressed).")
 print(f"NS_PER_POINT={ns_per_point:.2f}")
 print(f"NS_PER_ITERATION={ns_per_iteration:.2f}")
 print(f"US_PER_TILE={us_per_tile:.2f}")
-print(f"COMPRESS_MBPS={raw / 1e6 / med(compress):.0f}")
-print(f"COMPRESS_RATIO={raw / packed:.0f}")
 EOF
 cat tests/scale/calibration.env

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes a lower-resolution copy of a job: the same model, ranges and max_bounces, fewer
 samples (the longest range halved until the grid has at most --points points), its own
-output. Its result is the sample the cost model of the scaling simulation scales up
+output, uncompressed (the sample's time is the counting's). Its result is the sample the cost model of the scaling simulation scales up
 (tests/scale/simulate.sh).
 
     lowres_job.py JOB.toml OUT.toml OUTPUT.h5 [--points 2200000]
@@ -40,8 +40,10 @@ def main():
     while points() > a.points:
         longest = max(ranges, key=lambda r: r["n"])
         longest["n"] = (longest["n"] + 1) // 2
-    run = {k: v for k, v in job.get("run", {}).items() if k not in ("tile_points", "output")}
+    run = {k: v for k, v in job.get("run", {}).items() if k not in ("tile_points", "output", "compression")}
     run["output"] = a.output
+    # Counting only: compression is charged apart (scale_costs measures it on these data).
+    run["compression"] = 0
     job["run"] = run
     with open(a.out, "w") as f:
         f.write(f"# Lower-resolution sample of {a.job} for the scaling simulation (tests/scale/lowres_job.py).\n")

@@ -11,7 +11,8 @@
 // tiles of a fresh run in the order explore hands them out, job/tiles.hpp handout_order;
 // shared by all simulated ranks). Prints one
 // line: tiles, the block granule, total compute, the costliest tile, the ideal time at
-// RANKS ranks.
+// RANKS ranks, and (compressed jobs) how fast and how far the sample's data compress as a
+// rank compresses its tiles.
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -22,6 +23,10 @@
 #include <string>
 #include <vector>
 
+#include <chrono>
+
+#include "io/chunk_codec.hpp"
+#include "io/partial_file.hpp"
 #include "io/hdf5.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
@@ -33,6 +38,8 @@ using namespace superball;
 struct LowRes {
     std::vector<std::uint64_t> shape;
     std::vector<double> cost;  // seconds per point of each low-resolution cell, row-major
+    std::vector<std::uint32_t> counts;
+    std::vector<std::uint8_t> outcomes;
 };
 
 LowRes read_lowres(const std::string& path, double ns_per_point, double ns_per_iteration)
@@ -45,11 +52,51 @@ LowRes read_lowres(const std::string& path, double ns_per_point, double ns_per_i
     for (const std::uint64_t n : low.shape) points *= n;
     std::vector<std::uint32_t> counts(points);
     h5::check(H5Dread(data, H5T_NATIVE_UINT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, counts.data()), "read /wall_bounces");
+    low.outcomes.resize(points);
+    const h5::Id codes = h5::dataset_id(H5Dopen2(file, "/outcome", H5P_DEFAULT), "open /outcome");
+    h5::check(H5Dread(codes, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, low.outcomes.data()), "read /outcome");
     low.cost.resize(points);
     for (std::uint64_t i = 0; i < points; ++i) {
         low.cost[i] = (ns_per_point + ns_per_iteration * static_cast<double>(counts[i])) * 1e-9;
     }
+    low.counts = std::move(counts);
     return low;
+}
+
+// How the job's data compress, on the low-resolution sample's data: cut into chunks of the
+// job's tile points (the sample's grid cut as explore cuts one), each encoded as a rank
+// encodes a tile (io/chunk_codec.hpp, the job's level); the fastest of 3 passes. Returns raw
+// bytes per second and raw bytes over stored bytes. The sample's neighbouring points are
+// farther apart than the job's, so its data compress less well than the job's: the ratio
+// errs on the side of more bytes for rank 0 to write.
+std::pair<double, double> compression_of(const LowRes& low, const Job& job, std::uint64_t tile_points, std::uint64_t count_bytes)
+{
+    const Tiling tiles(low.shape, default_tile_shape(low.shape, tile_points));
+    ChunkEncoder encoder(job.compression);
+    std::vector<std::uint32_t> c, cc;
+    std::vector<std::uint8_t> o, oc;
+    std::vector<std::byte> out;
+    double best = 1e300;
+    std::uint64_t stored = 0;
+    for (int pass = 0; pass < 3; ++pass) {
+        stored = 0;
+        const auto start = std::chrono::steady_clock::now();
+        for (std::uint64_t t = 0; t < tiles.tiles(); ++t) {
+            const Box b = tiles.box(t);
+            c.resize(b.points());
+            o.resize(b.points());
+            copy_box(b, reinterpret_cast<const std::byte*>(low.counts.data()), Extent(low.shape.size(), 0), low.shape,
+                     reinterpret_cast<std::byte*>(c.data()), b.start, b.count, 4);
+            copy_box(b, reinterpret_cast<const std::byte*>(low.outcomes.data()), Extent(low.shape.size(), 0), low.shape,
+                     reinterpret_cast<std::byte*>(o.data()), b.start, b.count, 1);
+            out.clear();
+            stored += encoder.counts(in_chunk_layout<std::uint32_t>(tiles, t, c, cc), count_bytes, out);
+            stored += encoder.outcomes(in_chunk_layout<std::uint8_t>(tiles, t, o, oc), out);
+        }
+        best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    const double raw = static_cast<double>(low.counts.size() * (count_bytes + 1));
+    return {raw / best, raw / static_cast<double>(stored)};
 }
 
 // For one axis: how many of the full-resolution samples [start, start + count) fall in
@@ -138,14 +185,19 @@ int main(int argc, char** argv)
         out.write(reinterpret_cast<const char*>(cost.data()), static_cast<std::streamsize>(cost.size() * sizeof(double)));
         out.write(reinterpret_cast<const char*>(points.data()), static_cast<std::streamsize>(points.size() * sizeof(std::uint64_t)));
         // Blocks are multiples of this many tiles where they can be, as run_explore asks
-        // (one alignment unit of counts), and the tiles are handed out in its order.
-        const std::uint64_t granule = std::max<std::uint64_t>(1, job.alignment / (tiling.box(0).points() * count_bytes));
+        // (uncompressed: one alignment unit of counts; compressed tiles go to rank 0: 1), and
+        // the tiles are handed out in its order.
+        const std::uint64_t granule =
+            job.compression > 0 ? 1 : std::max<std::uint64_t>(1, job.alignment / (tiling.box(0).points() * count_bytes));
         std::vector<std::uint64_t> pending(tiling.tiles());
         for (std::uint64_t t = 0; t < tiling.tiles(); ++t) pending[t] = t;
         for (const std::uint64_t t : handout_order(pending, granule, ranks >= interleave_ranks_default)) put(out, t);
         if (!out) throw std::runtime_error(std::string("cannot write ") + argv[7]);
-        fmt::print("tiles={} tile_points={} granule={} compute_s={:.6g} costliest_tile_s={:.6g} ideal_s={:.6g}\n",
-                   tiling.tiles(), tiling.box(0).points(), granule, total, worst, total / ranks);
+        const auto [compress_bps, ratio] =
+            job.compression > 0 ? compression_of(low, job, tiling.tile_points(), count_bytes) : std::pair{0.0, 1.0};
+        fmt::print("tiles={} tile_points={} granule={} compute_s={:.6g} costliest_tile_s={:.6g} ideal_s={:.6g} "
+                   "compress_mbps={:.4g} compress_ratio={:.4g}\n",
+                   tiling.tiles(), tiling.box(0).points(), granule, total, worst, total / ranks, compress_bps / 1e6, ratio);
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "scale_costs: %s\n", e.what());

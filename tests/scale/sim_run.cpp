@@ -1,16 +1,20 @@
 // The real schedule (src/run/schedule.cpp, over src/mpi/mpi.cpp) under SimGrid's SMPI,
 // with counting and writing replaced by cost models: a tile costs what scale_costs
-// computed from a real result of the job (smpi_execute), and the writer's flushes, rank
-// 0's resume journal and the closing compression pass cost what the platform's shared file
-// system makes them: its disk's bandwidth, shared by every operation in flight, after the
-// latency per operation the disk's property op_latency states (S4U disk I/O).
+// computed from a real result of the job (smpi_execute), plus its compression; the
+// compressed tiles travel to rank 0 with the schedule's reports (the real messages carry
+// payloads of their modelled size), and rank 0's writer appends them to the shared file
+// system (S4U disk I/O: the disk's bandwidth, shared by every operation in flight, after the
+// latency per operation its property op_latency states; one client's bandwidth at most, its
+// property client_bw). Uncompressed runs (--uncompressed): every rank's writer thread writes
+// its tiles. The end as explore ends: rank 0 indexes the tiles in place and renames the file.
 // Built with smpicxx and run with smpirun by tests/scale/simulate.sh; prints one line of
 // key=value on rank 0.
 //
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
-//       [--flush-bytes 6291456] [--journal-seconds 10]
-//       [--compress-mbps 100] [--compress-ratio 100] [--no-io] [--no-closing] [--serve-every 0.05] [--server-serve-every 0.005] [--trace] [--trace-bucket 1]
+//       [--uncompressed] [--flush-bytes 6291456] [--journal-seconds 10] [--compress-mbps 650] [--compress-ratio 100]
+//       [--index-us-per-tile 1.04] [--startup-seconds 2] [--no-io] [--serve-every 0.05] [--server-serve-every 0.005]
+//       [--trace] [--trace-bucket 1]
 #include <fcntl.h>
 #include <mpi.h>
 #include <smpi/smpi.h>
@@ -20,10 +24,12 @@
 
 #include <simgrid/s4u/Actor.hpp>
 #include <simgrid/s4u/Comm.hpp>
+#include <simgrid/s4u/ConditionVariable.hpp>
 #include <simgrid/s4u/Disk.hpp>
 #include <simgrid/s4u/Engine.hpp>
 #include <simgrid/s4u/Host.hpp>
 #include <simgrid/s4u/Mailbox.hpp>
+#include <simgrid/s4u/Mutex.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -31,6 +37,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -90,12 +98,22 @@ private:
 struct Options {
     std::string costs;
     ScheduleSettings schedule;
-    double flush_bytes = 6 << 20;  // the writer's buffer: 4 MiB of 16-bit counts, 2 MiB of outcomes (run/explore.cpp)
+    bool compressed = true;        // tiles compressed by their rank, appended by rank 0 (the default)
+    double flush_bytes = 6 << 20;  // uncompressed: the writer's buffer, 4 MiB of 16-bit counts, 2 MiB of outcomes (run/explore.cpp)
+    double batch_bytes = 4 << 20;  // compressed: a rank's tiles leave at least this often (TileWork::should_flush)
+    double append_bytes = 8 << 20; // compressed: rank 0's append buffer (ChunkAppender)
     double journal_seconds = 10;
-    double compress_mbps = 100;    // shuffle + deflate, per core
-    double compress_ratio = 100;
+    double compress_mbps = 650;    // shuffle + deflate of a tile, per core (scale_costs measures the job's)
+    double compress_ratio = 100;   // raw bytes over stored bytes (likewise)
+    // Rank 0 indexing a tile where it lies: two H5Dwrite_chunk calls (0.52 us each for the
+    // 131072 chunks of the trivial 8192^2 grid in 1024-point tiles: 68 ms, measured in
+    // io/final_result.cpp with its phases timed).
+    double index_us_per_tile = 1.04;
+    // From mpirun starting to the job parsed on every rank: MPI_Init at this many ranks.
+    // An assumption (0.02 s here at 2 ranks with pml ob1; launches of thousands of ranks
+    // over UCX and PMIx take seconds), stated in the output.
+    double startup_seconds = 2;
     bool io = true;
-    bool closing = true;           // false: no closing pass (schedule experiments)
     bool trace = false;            // one line per rank on standard error (where the tail comes from)
     double trace_bucket = 1;       // seconds: the waits between tiles summed over ranks by this
     double serve_every = 0.05;     // most compute seconds between two Serve calls (see ModelWork)
@@ -118,12 +136,14 @@ Options parse(int argc, char** argv)
         else if (a == "--block-divisor") o.schedule.block_divisor = std::stoull(value());
         else if (a == "--dedicated-root-ranks") o.schedule.dedicated_root_ranks = std::stoi(value());
         else if (a == "--idle-poll") o.schedule.idle_poll_seconds = std::stod(value());
+        else if (a == "--uncompressed") o.compressed = false;
         else if (a == "--flush-bytes") o.flush_bytes = std::stod(value());
         else if (a == "--journal-seconds") o.journal_seconds = std::stod(value());
         else if (a == "--compress-mbps") o.compress_mbps = std::stod(value());
         else if (a == "--compress-ratio") o.compress_ratio = std::stod(value());
+        else if (a == "--index-us-per-tile") o.index_us_per_tile = std::stod(value());
+        else if (a == "--startup-seconds") o.startup_seconds = std::stod(value());
         else if (a == "--no-io") o.io = false;
-        else if (a == "--no-closing") o.closing = false;
         else if (a == "--trace") o.trace = true;
         else if (a == "--trace-bucket") o.trace_bucket = std::stod(value());
         else if (a == "--serve-every") o.serve_every = std::stod(value());
@@ -149,9 +169,31 @@ public:
         const char* latency = disk_->get_property("op_latency");
         if (!latency) throw std::runtime_error("the platform's disk of host fs states no op_latency");
         latency_ = std::stod(latency);
+        const char* client = disk_->get_property("client_bw");
+        if (!client) throw std::runtime_error("the platform's disk of host fs states no client_bw (bytes/s of one client)");
+        client_bw_ = std::stod(client);
     }
     void write(double bytes) { io(bytes, true); }
     void read(double bytes) { io(bytes, false); }
+    // An operation on the file system's metadata (create, open, close, rename): its latency.
+    void metadata()
+    {
+        if (!on_) return;
+        ++operations;
+        simgrid::s4u::this_actor::sleep_for(latency_);
+    }
+    // One client's write: no faster than the client's own bandwidth, nor than its share of
+    // the file system's.
+    void client_write(double bytes)
+    {
+        if (!on_ || bytes <= 0) return;
+        ++operations;
+        simgrid::s4u::this_actor::sleep_for(latency_);
+        const double begin = simgrid::s4u::Engine::get_clock();
+        disk_->write(static_cast<sg_size_t>(std::ceil(bytes)));
+        const double rest = bytes / client_bw_ - (simgrid::s4u::Engine::get_clock() - begin);
+        if (rest > 0) simgrid::s4u::this_actor::sleep_for(rest);
+    }
     std::uint64_t operations = 0;
 
 private:
@@ -166,6 +208,7 @@ private:
     }
 
     double latency_ = 0;
+    double client_bw_ = 0;
     bool on_;
     simgrid::s4u::Disk* disk_ = nullptr;
 };
@@ -230,20 +273,94 @@ private:
     bool busy_ = false;
 };
 
+// Rank 0's writer of compressed tiles (io/partial_file.cpp, ChunkAppender): payloads
+// gathered while a write is in flight leave in the next write, at once when none is; one
+// client's write (FileSystem::client_write). An S4U actor on rank 0's host; rank 0 waits for
+// it only at a checkpoint and at the end.
+class Appender {
+public:
+    explicit Appender(FileSystem& fs)
+        : fs_(fs), mutex_(simgrid::s4u::Mutex::create()), work_(simgrid::s4u::ConditionVariable::create()),
+          idle_(simgrid::s4u::ConditionVariable::create())
+    {
+        simgrid::s4u::Actor::create("appender", simgrid::s4u::this_actor::get_host(), [this] { loop(); })->daemonize();
+    }
+    Appender(const Appender&) = delete;
+    Appender& operator=(const Appender&) = delete;
+    ~Appender()
+    {
+        drain();
+        const std::unique_lock lock(*mutex_);
+        quit_ = true;
+        work_->notify_all();
+    }
+    void add(double bytes)
+    {
+        const std::unique_lock lock(*mutex_);
+        pending_ += bytes;
+        backlog = std::max(backlog, pending_);
+        work_->notify_all();
+    }
+    // Waits until every byte added is written.
+    void drain()
+    {
+        std::unique_lock lock(*mutex_);
+        while (pending_ > 0 || writing_) idle_->wait(lock);
+    }
+    double written = 0;
+    double backlog = 0;   // the most bytes waiting for a write at once
+    double busy_s = 0;    // time spent writing
+
+private:
+    // (Condition variables, not mailboxes: SMPI takes a mailbox's payload for an MPI
+    // buffer and frees it.)
+    void loop()
+    {
+        std::unique_lock lock(*mutex_);
+        for (;;) {
+            while (pending_ == 0 && !quit_) work_->wait(lock);
+            if (quit_) return;
+            const double bytes = pending_;
+            pending_ = 0;
+            writing_ = true;
+            lock.unlock();
+            const double begin = simgrid::s4u::Engine::get_clock();
+            fs_.client_write(bytes);
+            lock.lock();
+            busy_s += simgrid::s4u::Engine::get_clock() - begin;
+            written += bytes;
+            writing_ = false;
+            if (pending_ == 0) idle_->notify_all();
+        }
+    }
+
+    FileSystem& fs_;
+    simgrid::s4u::MutexPtr mutex_;
+    simgrid::s4u::ConditionVariablePtr work_;
+    simgrid::s4u::ConditionVariablePtr idle_;
+    double pending_ = 0;
+    bool writing_ = false;
+    bool quit_ = false;
+};
+
 // Counting replaced by smpi_execute of the tile's modelled cost, in pieces with the Serve
 // callback between them. The real counter calls it every Serve::points points (512, 64
 // on a node leader); so does the model where that many points cost more than
 // --serve-every seconds (--server-serve-every on a leader: a rank holding heavy tiles
 // answers as late as the real one), and every --serve-every seconds of compute elsewhere
-// (fewer events: answers come later than in the real run by at most that, never sooner);
-// writing as the writer does: tiles buffered until ~6 MiB, a tile that does not follow the
-// last, or a flush, then one write to /wall_bounces and one to /outcome on the writer
-// thread.
+// (fewer events: answers come later than in the real run by at most that, never sooner).
+// Compressed (the default): the tile's compression costs its raw bytes at
+// --compress-mbps, and its stored bytes (raw / --compress-ratio) join the rank's batch,
+// which leaves with its reports at least every report period, or when it holds
+// --batch-bytes: the payload of the real message is that many bytes. Uncompressed: as the
+// writer does, tiles buffered until ~6 MiB, a tile that does not follow the last, or a
+// flush, then one write to /wall_bounces and one to /outcome on the writer thread.
 class ModelWork final : public TileWork {
 public:
     ModelWork(const Costs& c, FileSystem& fs, const Options& o, int rank)
         : costs_(c),
           writer_(fs, rank),
+          options_(o),
           flush_bytes_(o.flush_bytes),
           serve_every_(o.serve_every),
           server_serve_every_(o.server_serve_every),
@@ -253,8 +370,10 @@ public:
 
     void compute(std::uint64_t tile, const Serve& serve) override
     {
-        const double cost = costs_.cost(tile);
         const std::uint64_t points = costs_.tile_points(tile);
+        const double raw = static_cast<double>(points * costs_.bytes_per_point());
+        const double compress = options_.compressed ? raw / (options_.compress_mbps * 1e6) : 0.0;
+        const double cost = costs_.cost(tile) + compress;
         // Time since the last tile (waiting, scheduling, writing), by second of the run.
         const double begin = MPI_Wtime();
         if (begin > last_end) {
@@ -262,9 +381,11 @@ public:
             if (second >= gaps.size()) gaps.resize(second + 1, 0.0);
             gaps[second] += begin - last_end;
         }
-        // A tile that does not follow the buffered ones, or a full buffer, is written first.
-        const double bytes = static_cast<double>(points * costs_.bytes_per_point());
-        if (buffered_points_ > 0 && (tile != next_tile_ || buffered_bytes_ + bytes > flush_bytes_)) issue();
+        // Uncompressed: a tile that does not follow the buffered ones, or a full buffer, is
+        // written first.
+        if (!options_.compressed && buffered_points_ > 0 && (tile != next_tile_ || buffered_bytes_ + raw > flush_bytes_)) {
+            issue();
+        }
         // A rank serving many calls Serve more often (schedule.hpp, Serve::points).
         const double every = serve.points < 512 ? server_serve_every_ : serve_every_;
         const auto wanted = static_cast<std::uint64_t>(std::ceil(cost / every));
@@ -280,21 +401,33 @@ public:
         next_tile_ = tile + 1;
         buffered_points_ += points;
         buffered_.push_back(tile);
-        buffered_bytes_ += bytes;
+        buffered_bytes_ += options_.compressed ? raw / options_.compress_ratio : raw;
     }
 
-    std::vector<TileReport> flush() override
+    Flushed flush() override
     {
+        Flushed out;
+        if (options_.compressed) {
+            for (const std::uint64_t t : buffered_) out.reports.push_back({t, t});
+            out.payload.resize(static_cast<std::size_t>(std::ceil(buffered_bytes_)));
+            payload_bytes += static_cast<double>(out.payload.size());
+            buffered_.clear();
+            buffered_points_ = 0;
+            buffered_bytes_ = 0;
+            return out;
+        }
         issue();
         writer_.wait();
-        std::vector<TileReport> out;
-        for (const std::uint64_t t : written_) out.push_back({t, t});
+        for (const std::uint64_t t : written_) out.reports.push_back({t, t});
         written_.clear();
         return out;
     }
 
+    bool should_flush() const override { return options_.compressed && buffered_bytes_ >= options_.batch_bytes; }
+
     double busy = 0;
     std::uint64_t tiles = 0;
+    double payload_bytes = 0;  // compressed bytes this rank sent
     double last_end = 0;       // set to the start of the run before the first tile
     double bucket = 1;         // of the gaps, in seconds
     std::vector<double> gaps;  // seconds between tiles (and before the first), by bucket of the run their wait began
@@ -314,6 +447,7 @@ private:
 
     const Costs& costs_;
     WriterThread writer_;
+    const Options& options_;
     double flush_bytes_;
     double serve_every_;
     double server_serve_every_;
@@ -336,26 +470,53 @@ int run(int argc, char** argv)
     static const Costs costs(o.costs);
     FileSystem fs(o);
     ModelWork work(costs, fs, o, rank);
+    const double tiles = static_cast<double>(costs.tiles());
 
-    // Rank 0's resume journal: the reports since the last one, every journal_seconds.
+    // The start: rank 0 creates the partial file (create, metadata, the journal of 33 bytes
+    // a tile, close), every rank opens it; the other ranks wait for its layout.
+    const double t0 = MPI_Wtime();
+    if (rank == 0) {
+        fs.metadata();
+        fs.write(33.0 * tiles + 65536);
+        fs.metadata();
+    }
+    world.barrier();
+    fs.metadata();  // every rank's open (POSIX, for uncompressed writes and the resume check)
+    world.barrier();
+
+    // Rank 0: the appender of compressed tiles, and the resume journal every
+    // journal_seconds: the appender drained, the journal written (24 + 8 + 1 bytes per tile
+    // recorded), the file covered (an HDF5 open, the superblock written, a close).
+    std::optional<Appender> appender;
+    if (rank == 0 && o.compressed && o.io) appender.emplace(fs);
     std::uint64_t unjournaled = 0;
-    double next_journal = o.journal_seconds;
+    double next_journal = MPI_Wtime() + o.journal_seconds;
+    const auto journal = [&] {
+        if (appender) appender->drain();
+        fs.write(33.0 * static_cast<double>(unjournaled) + 4096);
+        if (appender) {
+            fs.metadata();
+            fs.write(4096);
+            fs.metadata();
+        }
+        unjournaled = 0;
+    };
     // Progress on standard error every tenth of the tiles: long simulations are long.
     std::uint64_t reported = 0;
     std::uint64_t next_mark = costs.tiles() / 10;
     const auto wall_start = std::chrono::steady_clock::now();
-    const TilesDone done = [&](std::span<const TileReport> tiles, int) {
-        reported += tiles.size();
+    const TilesDone done = [&](std::span<const TileReport> tiles_done, int, std::span<const std::byte> payload) {
+        reported += tiles_done.size();
         if (reported >= next_mark && next_mark > 0) {
             std::fprintf(stderr, "sim_run: %llu of %llu tiles reported at %.1f simulated s, %.0f s of wall time\n",
                          static_cast<unsigned long long>(reported), static_cast<unsigned long long>(costs.tiles()),
                          MPI_Wtime(), std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
             next_mark += costs.tiles() / 10;
         }
-        unjournaled += tiles.size();
+        if (appender) appender->add(static_cast<double>(payload.size()));
+        unjournaled += tiles_done.size();
         if (MPI_Wtime() >= next_journal) {
-            fs.write(16.0 * static_cast<double>(unjournaled) + 4096);
-            unjournaled = 0;
+            journal();
             next_journal = MPI_Wtime() + o.journal_seconds;
         }
     };
@@ -364,8 +525,7 @@ int run(int argc, char** argv)
     work.last_end = start;
     work.bucket = o.trace_bucket;
     const ScheduleResult r = run_schedule(world, costs.pending(), work, done, [] { return false; }, o.schedule);
-    if (rank == 0) fs.write(16.0 * static_cast<double>(unjournaled) + 4096);
-    const double scheduled = MPI_Wtime();
+    const double scheduled = world.max(MPI_Wtime());
     if (o.trace) {
         // Every rank's time between tiles, summed by second of the run: where the waits are.
         const auto seconds = static_cast<std::size_t>(world.max(static_cast<double>(work.gaps.size())));
@@ -384,33 +544,35 @@ int run(int argc, char** argv)
                      r.stats.idle_seconds, r.stats.leader ? 1 : 0);
     }
 
-    // The closing pass: every rank gathers its share of the raw data, compresses it and
-    // writes the compressed result. From 64 ranks on, when a share fits in 256 MiB
-    // (run/explore.hpp, ExploreSettings::closing_memory_*), the ranks that computed the tiles
-    // send them (modelled as one exchange of a share with a rank of another node: every node
-    // sends and receives its ranks' shares over its link); otherwise each rank reads its share
-    // back from the file system.
+    // The end (run/explore.cpp): rank 0's last write and the journal, every rank closes
+    // the file, then rank 0 alone makes it the result: every tile indexed where it lies
+    // (CPU, and the index written: two entries of 16 bytes a tile), the attributes, the
+    // close, the rename, the sidecar.
+    double finish_start = 0;
+    if (rank == 0) {
+        if (appender) appender->drain();
+        journal();
+        finish_start = MPI_Wtime();
+    }
     world.barrier();
-    const double raw = static_cast<double>(costs.points() * costs.bytes_per_point());
-    if (o.io && o.closing) {
-        const double share = raw / ranks;
-        if (ranks >= 64 && share <= double(std::uint64_t{256} << 20)) {
-            // Sizes without data: an S4U message of the share's size to a rank half the
-            // machine away, and one from the rank as far the other way.
-            const auto to = simgrid::s4u::Mailbox::by_name("closing-" + std::to_string((rank + ranks / 2) % ranks));
-            const auto from = simgrid::s4u::Mailbox::by_name("closing-" + std::to_string(rank));
-            static char token = 0;
-            const simgrid::s4u::CommPtr sent = to->put_async(&token, static_cast<std::uint64_t>(share));
-            from->get<char>();
-            sent->wait();
-        } else {
-            fs.read(share);
+    if (rank == 0 && o.io) {
+        fs.metadata();  // open
+        if (o.compressed) {
+            smpi_execute(o.index_us_per_tile * 1e-6 * tiles);
+            fs.write(32.0 * tiles);
         }
-        smpi_execute(share / (o.compress_mbps * 1e6));
-        fs.write(share / o.compress_ratio);
+        fs.write(4096);  // attributes, journal unlinked
+        fs.metadata();   // close
+        fs.metadata();   // rename
+        fs.metadata();   // the sidecar: create, write, close
+        fs.write(1024);
     }
     world.barrier();
     const double end = MPI_Wtime();
+    const double written = appender ? appender->written : 0.0;
+    const double backlog = appender ? appender->backlog : 0.0;
+    const double writer_busy = appender ? appender->busy_s : 0.0;
+    appender.reset();
 
     // Reductions, not a gather: SMPI's gather to one rank of 4096 waits on its requests one
     // by one (minutes of wall time).
@@ -425,25 +587,28 @@ int run(int argc, char** argv)
         reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start},
                MPI_MAX);
     const std::vector<double> sums = reduce({static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
-                                             r.stats.computed ? r.stats.idle_seconds : 0.0},
+                                             r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes},
                                             MPI_SUM);
     if (rank == 0) {
         double total = 0;
         for (std::uint64_t t = 0; t < costs.tiles(); ++t) total += costs.cost(t);
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
-        const double ops = sums[0], given_back = sums[1], idle = sums[2];
-        const double predicted = end - start;
+        const double ops = sums[0], given_back = sums[1], idle = sums[2], payload = sums[3];
+        // From mpirun starting (the stated start-up) to the result renamed; and the compute
+        // phase, from the first tile handed out to the last done, as explore reports it.
+        const double end_to_end = o.startup_seconds + (end - t0);
         const double ideal = total / ranks;
-        std::printf("ranks=%d efficiency=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "
-                    "finish_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu root_messages=%llu "
-                    "max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f root_asked_back=%llu idle_s_per_rank=%.6g "
-                    "reported=%llu\n",
-                    ranks, ideal / predicted, predicted, ideal, total, schedule_s, end - scheduled,
-                    last_busy - first_idle, static_cast<unsigned long long>(costs.tiles()),
-                    static_cast<unsigned long long>(r.stats.requests_in),
-                    static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(),
-                    ops, r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back),
-                    idle / ranks, static_cast<unsigned long long>(reported));
+        std::printf("ranks=%d efficiency=%.4f end_to_end=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "
+                    "startup_s=%.6g create_s=%.6g finish_s=%.6g closing_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu "
+                    "root_messages=%llu max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f "
+                    "root_asked_back=%llu idle_s_per_rank=%.6g reported=%llu compressed=%d payload_bytes=%.6g "
+                    "written_by_root=%.6g writer_busy_s=%.6g writer_backlog_bytes=%.6g\n",
+                    ranks, ideal / (scheduled - start), ideal / end_to_end, end_to_end, ideal, total, schedule_s,
+                    o.startup_seconds, start - t0, end - finish_start, end - scheduled, last_busy - first_idle,
+                    static_cast<unsigned long long>(costs.tiles()), static_cast<unsigned long long>(r.stats.requests_in),
+                    static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(), ops,
+                    r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back), idle / ranks,
+                    static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writer_busy, backlog);
         std::fflush(stdout);
     }
     return 0;

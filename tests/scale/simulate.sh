@@ -4,14 +4,17 @@
 # OUT/sim_run) and cost models for counting and writing. Prints one line per job and rank
 # count:
 #
-#   job=NAME ranks=N efficiency=E predicted_s=T
+#   job=NAME ranks=N efficiency=E end_to_end=E2 predicted_s=T
 #
-# efficiency = ideal / predicted, ideal = the job's total compute / N, predicted = the
-# simulated time from the first tile handed out to the result closed (the closing pass
-# included). The details of each run (schedule and closing times, the tail, messages rank
-# 0 received, tiles given back, file-system operations) are in OUT/logs/NAME.N.log.
+# ideal = the job's total counting / N; efficiency = ideal / the compute phase (the first
+# tile handed out to the last one done, as explore reports it); end_to_end = ideal / T, T
+# the predicted time from mpirun starting (a stated start-up, --startup-seconds, default 2
+# s: MPI_Init at thousands of ranks, an assumption) to the result renamed. The details of
+# each run (schedule and finish times, the tail, messages rank 0 received, tiles given back,
+# file-system operations, the bytes rank 0 wrote and its writer's backlog) are in
+# OUT/logs/NAME.N.log.
 #
-#   tests/scale/simulate.sh [--ranks "64 256 1024 4096"] [--out DIR] [--no-build] [JOB.toml...]
+#   tests/scale/simulate.sh [--ranks "64 256 1024 4096"] [--startup-seconds S] [--out DIR] [--no-build] [JOB.toml...]
 #
 # Default: every job of jobs/cluster, OUT = build/scale. --no-build: use the superball and
 # scale_costs of build/release (or $SUPERBALL_BUILD_DIR) as they are (the ctest smoke run).
@@ -28,11 +31,11 @@
 #      map steps in some regions than in others). Blocks are multiples of the granule
 #      explore uses ([run] alignment / bytes of a tile's counts);
 #   3. smpirun on tests/scale/cluster.xml (128 nodes x 32 cores as fast as this machine's,
-#      fat tree, a file system of 20 GB/s with 1 ms per operation): sim_run replays the
-#      tiles' costs and the writer's I/O (flushes of 6 MiB, a resume journal on rank 0
-#      every 10 s, a closing pass that reads the raw data back, compresses it at
-#      COMPRESS_MBPS per core and writes it smaller by the ratio of the job's
-#      low-resolution result).
+#      fat tree, a file system of 20 GB/s with 1 ms per operation, 2 GB/s for one client):
+#      sim_run replays the tiles' costs, each tile's compression (at the speed and ratio
+#      scale_costs measured compressing the sample's data as a rank does), the compressed
+#      bytes sent to rank 0 with the reports, rank 0's writer appending them, its journal
+#      every 10 s, and the finish (index, rename); uncompressed jobs, every rank's writer.
 #
 # Installs SimGrid if missing (.ci/install-deps --scale). The simulated ranks run one
 # after the other on one core: seconds for 64 ranks, minutes for 4096 (README, Running on
@@ -41,16 +44,18 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 cd "$root"
 ranks="64 256 1024 4096"
+startup=2
 out=$root/build/scale
 build=true
 jobs=()
 while (($# > 0)); do
   case $1 in
     --ranks) ranks=$2; shift 2 ;;
+    --startup-seconds) startup=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --no-build) build=false; shift ;;
-    -h|--help) sed -n '2,36p' "$0"; exit 0 ;;
-    -*) echo "simulate: unknown option $1 (accepted: --ranks, --out, --no-build, --help)" >&2; exit 2 ;;
+    -h|--help) sed -n '2,42p' "$0"; exit 0 ;;
+    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --out, --no-build, --help)" >&2; exit 2 ;;
     *) jobs+=("$1"); shift ;;
   esac
 done
@@ -98,8 +103,12 @@ for job in "${jobs[@]}"; do
     log=$out/logs/$name.$n.log
     # 2. Tile costs for this rank count's tiling; 3. the simulated run.
     "$scale_costs" "$job" "$n" "$out/lowres/$name.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs" >"$log"
-    echo "simulate: ns_per_iteration=$ns_per_iteration compress_ratio=$ratio (from $out/lowres/$name.h5)" >>"$log"
+    echo "simulate: ns_per_iteration=$ns_per_iteration (from $out/lowres/$name.h5)" >>"$log"
     granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' "$log")
+    compress_mbps=$(sed -n 's/.* compress_mbps=\([0-9.e+]*\).*/\1/p' "$log")
+    compress_ratio=$(sed -n 's/.* compress_ratio=\([0-9.e+]*\).*/\1/p' "$log")
+    write=(--compress-mbps "$compress_mbps" --compress-ratio "$compress_ratio")
+    [[ $compress_mbps == 0 ]] && write=(--uncompressed)
     # Serve is called every 512 points in the real counter; the model calls it at least
     # every 1/2000 of the ideal run time (0.05 s at 4096 ranks), which keeps the number of
     # simulated events per run the same at every rank count (answers come later than in
@@ -107,14 +116,15 @@ for job in "${jobs[@]}"; do
     serve_every=$(sed -n 's/.* ideal_s=\([0-9.e+]*\).*/\1/p' "$log" | /usr/bin/python3 -c 'import sys; print(max(0.05, float(sys.stdin.read()) / 2000))')
     start=$SECONDS
     smpirun -np "$n" -platform tests/scale/cluster.xml -hostfile "$out/hosts" "$out/sim_run" "$costs" \
-      --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" --compress-mbps "$COMPRESS_MBPS" --compress-ratio "$ratio" \
+      --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" "${write[@]}" --startup-seconds "$startup" \
       "${smpi[@]}" >>"$log" 2>&1
     echo "simulate: $name at $n ranks took $((SECONDS - start)) s of wall time" >>"$log"
     line=$(grep '^ranks=' "$log" | tail -1)
     [[ -n $line ]] || { echo "simulate: no result for $name at $n ranks; see $log" >&2; exit 1; }
     efficiency=$(sed -n 's/.* efficiency=\([^ ]*\).*/\1/p' <<<"$line")
+    end_to_end=$(sed -n 's/.* end_to_end=\([^ ]*\).*/\1/p' <<<"$line")
     predicted=$(sed -n 's/.* predicted_s=\([^ ]*\).*/\1/p' <<<"$line")
-    echo "job=$name ranks=$n efficiency=$efficiency predicted_s=$predicted"
+    echo "job=$name ranks=$n efficiency=$efficiency end_to_end=$end_to_end predicted_s=$predicted"
     rm -f "$costs"
   done
 done

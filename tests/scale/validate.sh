@@ -64,12 +64,16 @@ computed() {  # compute-phase seconds of real runs, the median of REPS: JOB RANK
   tests/scale/computed.sh "$superball" "$1" "$reps" "$2" "$out/real.h5"
 }
 predicted() {  # schedule_s of the simulation: NAME JOB RANKS NS_PER_ITERATION
-  local granule
-  granule=$("$scale_costs" "$2" "$3" "$out/$1.low.h5" "$NS_PER_POINT" "$4" "$US_PER_TILE" "$out/$1.$3.bin" |
-    sed -n 's/.* granule=\([0-9]*\) .*/\1/p')
+  local line granule write
+  line=$("$scale_costs" "$2" "$3" "$out/$1.low.h5" "$NS_PER_POINT" "$4" "$US_PER_TILE" "$out/$1.$3.bin")
+  granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' <<<"$line")
+  # Each tile's compression charged as simulate.sh charges it (the real runs compress).
+  write=(--compress-mbps "$(sed -n 's/.* compress_mbps=\([0-9.e+]*\).*/\1/p' <<<"$line")"
+         --compress-ratio "$(sed -n 's/.* compress_ratio=\([0-9.e+]*\).*/\1/p' <<<"$line")")
+  [[ ${write[1]} == 0 ]] && write=(--uncompressed)
   echo "node-0:$3" >"$out/hosts"
   smpirun -np "$3" -platform tests/scale/local.xml -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$1.$3.bin" \
-    --node-ranks "$3" --granule "$granule" --no-io --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no \
+    --node-ranks "$3" --granule "$granule" "${write[@]}" --no-io --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no \
     --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536 2>"$out/$1.$3.log" |
     sed -n 's/.* schedule_s=\([^ ]*\).*/\1/p'
   rm -f "$out/$1.$3.bin"
