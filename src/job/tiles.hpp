@@ -92,10 +92,16 @@ Extent default_tile_shape(const Extent& shape, std::uint64_t target_points);
 // compressed on its own: big enough (up to 2^18 points, 512 KiB of 16-bit counts) that a
 // deflate stream's fixed costs (its header and code tables, an index entry: about 150
 // bytes a chunk) stay small against what it holds and readers decompress few chunks;
-// small enough that the dynamic schedule can balance very unequal costs: 16 tiles per
-// rank, but never below 2^17 points while that leaves 4 tiles per rank (the 1024^2
-// quickstart slice on 2 ranks: 8 tiles of 2^17 points, a 53 KB result; in 32 tiles of 2^15,
-// 56 KB; its compute phase takes 10 ms either way), and never below 1024 points.
+// small enough that the dynamic schedule can balance very unequal costs.
+// - Below interleave_ranks_default (64) ranks: 16 tiles per rank, but never below 2^17
+//   points while that leaves 4 tiles per rank (the 1024^2 quickstart slice on 2 ranks: 8
+//   tiles of 2^17 points, a 53 KB result; in 32 tiles of 2^15, 56 KB; its compute phase
+//   takes 10 ms either way), and never below 1024 points.
+// - From 64 ranks on: 256 tiles per rank, 1024 to 2^16 points. The end of a run on
+//   thousands of ranks waits for its costliest tile: the corner zoom of jobs/cluster at
+//   4096 simulated ranks counted at 0.874 of the ideal in tiles of 2^16 points and 0.967
+//   in tiles of 2^14 (tests/scale/simulate.sh); its data compress 4 times only, so a chunk's
+//   fixed bytes cost it under 1 %.
 std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks);
 
 // From this many ranks on, a run hands out its tiles interleaved (handout_order).

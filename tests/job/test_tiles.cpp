@@ -72,6 +72,28 @@ TEST(HandoutOrder, EveryTileOnceAndIncompleteGranulesLast)
     EXPECT_EQ(tail, expected);
 }
 
+// Tiles are the result's chunks: large on a workstation (the file's size), many per rank
+// on a cluster (the end of the schedule).
+TEST(DefaultTilePoints, LargeChunksOnFewRanksManyTilesOnMany)
+{
+    constexpr std::uint64_t k = 1024;
+    // The 8192^2 benchmark slice at 1 and 2 ranks: the largest tiles, 2^18 points.
+    EXPECT_EQ(default_tile_points(8192 * 8192, 1), 256 * k);
+    EXPECT_EQ(default_tile_points(8192 * 8192, 2), 256 * k);
+    // The 1024^2 quickstart slice: 2^17 points, 8 tiles at 1 or 2 ranks (4 tiles a rank at
+    // least), not 16 a rank of 2^15.
+    EXPECT_EQ(default_tile_points(1024 * 1024, 1), 128 * k);
+    EXPECT_EQ(default_tile_points(1024 * 1024, 2), 128 * k);
+    EXPECT_EQ(default_tile_points(1024 * 1024, 16), 16 * k);  // 4 tiles a rank
+    // Small grids: 1024 points at least.
+    EXPECT_EQ(default_tile_points(64 * 64, 2), k);
+    EXPECT_EQ(default_tile_points(10, 1), k);
+    // From 64 ranks: 256 tiles a rank, at most 2^16 points.
+    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 2048 * 2048, 4096), 16 * k);
+    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 2048 * 2048, 1024), 64 * k);
+    EXPECT_EQ(default_tile_points(8192 * 8192, 64), 4 * k);
+}
+
 TEST(HandoutOrder, NothingPending)
 {
     EXPECT_TRUE(handout_order({}, 8, true).empty());
