@@ -1,19 +1,24 @@
 // The real schedule (src/run/schedule.cpp, over src/mpi/mpi.cpp) under SimGrid's SMPI,
-// with counting and writing replaced by cost models: a tile costs what scale_costs
-// computed from a real result of the job (smpi_execute), plus its compression; the
-// compressed tiles travel to rank 0 with the schedule's reports (the real messages carry
-// payloads of their modelled size), and rank 0's writer appends them to the shared file
-// system (S4U disk I/O: the disk's bandwidth, shared by every operation in flight, after the
-// latency per operation its property op_latency states; one client's bandwidth at most, its
-// property client_bw). Uncompressed runs (--uncompressed): every rank's writer thread writes
-// its tiles. The end as explore ends: rank 0 indexes the tiles in place and renames the file.
-// Built with smpicxx and run with smpirun by tests/scale/simulate.sh; prints one line of
-// key=value on rank 0.
+// with counting and writing replaced by cost models. Compressed (the default): a tile costs
+// what scale_costs computed from a real result of the job, plus its compression at
+// --compress-mbps (smpi_execute, on the rank that counted it); its stored bytes (raw /
+// --compress-ratio) travel to rank 0 in the payloads of the schedule's own report messages
+// (rank -> node leader -> rank 0: the real messages, of the modelled size, over the
+// platform's links, rank 0's included); rank 0 copies them (--copy-gbps) and its appender
+// (ChunkAppender's two buffers and one writer at a time) writes them through rank 0's
+// client (the platform's client_bw) to the shared file system (S4U disk I/O: the disk's
+// bandwidth, shared by every operation in flight, after the latency per operation its
+// property op_latency states); a checkpoint every --journal-seconds (the appender flushed,
+// the journal's dirty range written, the file covered); the finish: the tiles indexed in
+// place (--index-us-per-tile of rank 0's CPU each, the index written), the rename, the
+// sidecar. Uncompressed runs (--uncompressed): every rank's writer thread writes its tiles
+// at their offsets; the same finish without the index. Built with smpicxx and run with
+// smpirun by tests/scale/simulate.sh; prints one line of key=value on rank 0.
 //
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
 //       [--uncompressed] [--flush-bytes 6291456] [--journal-seconds 10] [--compress-mbps 650] [--compress-ratio 100]
-//       [--index-us-per-tile 1.04] [--startup-seconds 2] [--no-io] [--serve-every 0.05] [--server-serve-every 0.005]
+//       [--index-us-per-tile 4] [--copy-gbps 10] [--startup-seconds 2] [--no-io] [--serve-every 0.05] [--server-serve-every 0.005]
 //       [--trace] [--trace-bucket 1]
 #include <fcntl.h>
 #include <mpi.h>
@@ -103,12 +108,14 @@ struct Options {
     double batch_bytes = 4 << 20;  // compressed: a rank's tiles leave at least this often (TileWork::should_flush)
     double append_bytes = 8 << 20; // compressed: rank 0's append buffer (ChunkAppender)
     double journal_seconds = 10;
-    double compress_mbps = 650;    // shuffle + deflate of a tile, per core (scale_costs measures the job's)
-    double compress_ratio = 100;   // raw bytes over stored bytes (likewise)
-    // Rank 0 indexing a tile where it lies: two H5Dwrite_chunk calls (0.52 us each for the
-    // 131072 chunks of the trivial 8192^2 grid in 1024-point tiles: 68 ms, measured in
-    // io/final_result.cpp with its phases timed).
-    double index_us_per_tile = 1.04;
+    double compress_mbps = 650;    // shuffle + deflate of a tile, raw MB/s per core (the job's: chunk_ratio.py, codec_speed)
+    double compress_ratio = 100;   // raw bytes over stored bytes (the job's: chunk_ratio.py)
+    // Rank 0's CPU per tile at the finish (two H5Dwrite_chunk calls, the journal's entry):
+    // tests/scale/calibrate.sh measures it (INDEX_US_PER_TILE), simulate.sh passes it.
+    double index_us_per_tile = 4;
+    // Rank 0 copying payloads (TileBatch::unpack, ChunkAppender::add: two copies a byte), GB/s
+    // of payload: calibrate.sh measures it (COPY_GBPS), simulate.sh passes it.
+    double copy_gbps = 10;
     // From mpirun starting to the job parsed on every rank: MPI_Init at this many ranks.
     // An assumption (0.02 s here at 2 ranks with pml ob1; launches of thousands of ranks
     // over UCX and PMIx take seconds), stated in the output.
@@ -142,6 +149,7 @@ Options parse(int argc, char** argv)
         else if (a == "--compress-mbps") o.compress_mbps = std::stod(value());
         else if (a == "--compress-ratio") o.compress_ratio = std::stod(value());
         else if (a == "--index-us-per-tile") o.index_us_per_tile = std::stod(value());
+        else if (a == "--copy-gbps") o.copy_gbps = std::stod(value());
         else if (a == "--startup-seconds") o.startup_seconds = std::stod(value());
         else if (a == "--no-io") o.io = false;
         else if (a == "--trace") o.trace = true;
@@ -157,13 +165,19 @@ Options parse(int argc, char** argv)
 
 // The shared file system: the disk of the platform's host "fs", which every rank's
 // operations share (its bandwidth is the file system's aggregate), after the latency of an
-// operation (its property op_latency, in seconds: an RPC and a lock on Lustre).
+// operation (its property op_latency, in seconds: an RPC and a lock on Lustre). Rank 0's
+// own writes (the compressed result, the journal, the finish) also go through its client:
+// a disk of its own of the bandwidth the platform's property client_bw states, shared by
+// rank 0's writes in flight at once (its main thread's and its appender's), so that a write
+// of rank 0 takes as long as the slower of its share of the file system and its share of
+// its client.
 class FileSystem {
 public:
-    explicit FileSystem(const Options& o) : on_(o.io)
+    explicit FileSystem(const Options& o, int rank) : on_(o.io)
     {
         if (!on_) return;
-        const auto disks = simgrid::s4u::Host::by_name("fs")->get_disks();
+        simgrid::s4u::Host* fs = simgrid::s4u::Host::by_name("fs");
+        const auto disks = fs->get_disks();
         if (disks.empty()) throw std::runtime_error("the platform's host fs has no disk");
         disk_ = disks.front();
         const char* latency = disk_->get_property("op_latency");
@@ -171,28 +185,37 @@ public:
         latency_ = std::stod(latency);
         const char* client = disk_->get_property("client_bw");
         if (!client) throw std::runtime_error("the platform's disk of host fs states no client_bw (bytes/s of one client)");
-        client_bw_ = std::stod(client);
+        if (rank == 0) {
+            // Created by rank 0 alone, before any I/O; read and write at the client's speed.
+            const double bw = std::stod(client);
+            client_ = fs->create_disk("rank0-client", bw, bw)->seal();
+        }
     }
     void write(double bytes) { io(bytes, true); }
     void read(double bytes) { io(bytes, false); }
-    // An operation on the file system's metadata (create, open, close, rename): its latency.
+    // An operation on the file system's metadata (create, open, close, rename, unlink): its
+    // latency.
     void metadata()
     {
         if (!on_) return;
         ++operations;
         simgrid::s4u::this_actor::sleep_for(latency_);
     }
-    // One client's write: no faster than the client's own bandwidth, nor than its share of
-    // the file system's.
-    void client_write(double bytes)
+    // Rank 0's write of `bytes` in `ops` operations (each pays the latency once; `ops` 0:
+    // one per MiB, the RPCs Lustre makes of a burst of small writes into the client's cache,
+    // as HDF5's index pages at the finish): the data cross rank 0's client and the file
+    // system at once.
+    void client_write(double bytes, double ops = 1)
     {
         if (!on_ || bytes <= 0) return;
-        ++operations;
-        simgrid::s4u::this_actor::sleep_for(latency_);
-        const double begin = simgrid::s4u::Engine::get_clock();
-        disk_->write(static_cast<sg_size_t>(std::ceil(bytes)));
-        const double rest = bytes / client_bw_ - (simgrid::s4u::Engine::get_clock() - begin);
-        if (rest > 0) simgrid::s4u::this_actor::sleep_for(rest);
+        if (ops <= 0) ops = std::ceil(bytes / (1 << 20));
+        operations += static_cast<std::uint64_t>(ops);
+        simgrid::s4u::this_actor::sleep_for(latency_ * ops);
+        const auto n = static_cast<sg_size_t>(std::ceil(bytes));
+        const simgrid::s4u::IoPtr a = disk_->write_async(n);
+        const simgrid::s4u::IoPtr b = client_->write_async(n);
+        a->wait();
+        b->wait();
     }
     std::uint64_t operations = 0;
 
@@ -208,9 +231,9 @@ private:
     }
 
     double latency_ = 0;
-    double client_bw_ = 0;
     bool on_;
     simgrid::s4u::Disk* disk_ = nullptr;
+    simgrid::s4u::Disk* client_ = nullptr;
 };
 
 // The writer thread of a rank (io/partial_file.cpp, TileWriter): one buffer fills while
@@ -273,74 +296,88 @@ private:
     bool busy_ = false;
 };
 
-// Rank 0's writer of compressed tiles (io/partial_file.cpp, ChunkAppender): payloads
-// gathered while a write is in flight leave in the next write, at once when none is; one
-// client's write (FileSystem::client_write). An S4U actor on rank 0's host; rank 0 waits for
-// it only at a checkpoint and at the end.
+// Rank 0's writer of compressed tiles (io/partial_file.cpp, ChunkAppender), step by step:
+// two buffers of `capacity` (8 MiB); a batch joins the buffer that fills, which is written
+// at once when no write is in flight (or the one in flight is done), else when it holds
+// `capacity`; a batch that would take it past `capacity` first sends it off. Sending a
+// buffer off starts its write (a thread of its own: here an S4U actor on rank 0's host) and
+// then waits for the other buffer's write: rank 0 waits only when a buffer fills while the
+// other is still being written (then two writes are in flight for a moment, sharing rank
+// 0's client). flush() (a checkpoint, the end) sends the buffer off and waits for it.
 class Appender {
 public:
-    explicit Appender(FileSystem& fs)
-        : fs_(fs), mutex_(simgrid::s4u::Mutex::create()), work_(simgrid::s4u::ConditionVariable::create()),
-          idle_(simgrid::s4u::ConditionVariable::create())
+    Appender(FileSystem& fs, double capacity)
+        : fs_(fs), capacity_(capacity), mutex_(simgrid::s4u::Mutex::create()), done_(simgrid::s4u::ConditionVariable::create())
     {
-        simgrid::s4u::Actor::create("appender", simgrid::s4u::this_actor::get_host(), [this] { loop(); })->daemonize();
     }
     Appender(const Appender&) = delete;
     Appender& operator=(const Appender&) = delete;
-    ~Appender()
-    {
-        drain();
-        const std::unique_lock lock(*mutex_);
-        quit_ = true;
-        work_->notify_all();
-    }
+    ~Appender() { flush(); }
+
     void add(double bytes)
     {
-        const std::unique_lock lock(*mutex_);
-        pending_ += bytes;
-        backlog = std::max(backlog, pending_);
-        work_->notify_all();
+        const double now = simgrid::s4u::Engine::get_clock();
+        const auto second = static_cast<std::size_t>(now);
+        if (second >= ingress_.size()) ingress_.resize(second + 1, 0.0);
+        ingress_[second] += bytes;
+        if (buffer_[current_] > 0 && buffer_[current_] + bytes > capacity_) issue();
+        buffer_[current_] += bytes;
+        backlog = std::max(backlog, buffer_[0] + buffer_[1]);
+        if (buffer_[current_] >= capacity_ || !writing_[1 - current_]) issue();
     }
-    // Waits until every byte added is written.
-    void drain()
+    void flush()
     {
-        std::unique_lock lock(*mutex_);
-        while (pending_ > 0 || writing_) idle_->wait(lock);
+        issue();
+        wait(1 - current_);
     }
+    // The most payload bytes rank 0 received in one second of the run.
+    double peak_ingress() const { return ingress_.empty() ? 0.0 : *std::max_element(ingress_.begin(), ingress_.end()); }
+
     double written = 0;
-    double backlog = 0;   // the most bytes waiting for a write at once
-    double busy_s = 0;    // time spent writing
+    std::uint64_t writes = 0;
+    double backlog = 0;      // the most bytes received and not yet written (both buffers)
+    double busy_s = 0;       // time with a write in flight
+    double held_back_s = 0;  // time rank 0 waited for a write with a full buffer
 
 private:
-    // (Condition variables, not mailboxes: SMPI takes a mailbox's payload for an MPI
-    // buffer and frees it.)
-    void loop()
+    void issue()
+    {
+        const int b = current_;
+        if (buffer_[b] == 0) return;
+        writing_[b] = true;
+        ++writes;
+        if (in_flight_++ == 0) busy_since_ = simgrid::s4u::Engine::get_clock();
+        simgrid::s4u::Actor::create("appender-write", simgrid::s4u::this_actor::get_host(), [this, b] {
+            const double bytes = buffer_[b];
+            fs_.client_write(bytes);
+            const std::unique_lock lock(*mutex_);
+            written += bytes;
+            buffer_[b] = 0;
+            writing_[b] = false;
+            if (--in_flight_ == 0) busy_s += simgrid::s4u::Engine::get_clock() - busy_since_;
+            done_->notify_all();
+        });
+        current_ = 1 - b;
+        const double begin = simgrid::s4u::Engine::get_clock();
+        wait(current_);
+        held_back_s += simgrid::s4u::Engine::get_clock() - begin;
+    }
+    void wait(int b)
     {
         std::unique_lock lock(*mutex_);
-        for (;;) {
-            while (pending_ == 0 && !quit_) work_->wait(lock);
-            if (quit_) return;
-            const double bytes = pending_;
-            pending_ = 0;
-            writing_ = true;
-            lock.unlock();
-            const double begin = simgrid::s4u::Engine::get_clock();
-            fs_.client_write(bytes);
-            lock.lock();
-            busy_s += simgrid::s4u::Engine::get_clock() - begin;
-            written += bytes;
-            writing_ = false;
-            if (pending_ == 0) idle_->notify_all();
-        }
+        while (writing_[b]) done_->wait(lock);
     }
 
     FileSystem& fs_;
+    double capacity_;
     simgrid::s4u::MutexPtr mutex_;
-    simgrid::s4u::ConditionVariablePtr work_;
-    simgrid::s4u::ConditionVariablePtr idle_;
-    double pending_ = 0;
-    bool writing_ = false;
-    bool quit_ = false;
+    simgrid::s4u::ConditionVariablePtr done_;
+    double buffer_[2] = {0, 0};
+    bool writing_[2] = {false, false};
+    int current_ = 0;
+    int in_flight_ = 0;
+    double busy_since_ = 0;
+    std::vector<double> ingress_;  // payload bytes received, by second of the run
 };
 
 // Counting replaced by smpi_execute of the tile's modelled cost, in pieces with the Serve
@@ -409,7 +446,9 @@ public:
         Flushed out;
         if (options_.compressed) {
             for (const std::uint64_t t : buffered_) out.reports.push_back({t, t});
-            out.payload.resize(static_cast<std::size_t>(std::ceil(buffered_bytes_)));
+            // The message TileBatch::pack makes: the tile count, 4 words a tile (tile,
+            // checksum, the sizes of its stored counts and outcomes), the stored bytes.
+            out.payload.resize(static_cast<std::size_t>(std::ceil(buffered_bytes_)) + 8 + 32 * buffered_.size());
             payload_bytes += static_cast<double>(out.payload.size());
             buffered_.clear();
             buffered_points_ = 0;
@@ -468,43 +507,63 @@ int run(int argc, char** argv)
     // One mapping for the whole simulation: SMPI runs every rank as a thread of this
     // process (smpi/privatization:no, so this static is shared), one after the other.
     static const Costs costs(o.costs);
-    FileSystem fs(o);
+    FileSystem fs(o, rank);
     ModelWork work(costs, fs, o, rank);
     const double tiles = static_cast<double>(costs.tiles());
 
-    // The start: rank 0 creates the partial file (create, metadata, the journal of 33 bytes
-    // a tile, close), every rank opens it; the other ranks wait for its layout.
+    // The start (run/explore.cpp, io/partial_file.cpp create_partial): rank 0 creates the
+    // partial file (create, the HDF5 objects and the journal's datasets, 33 bytes a tile
+    // compressed, 9 uncompressed, a flush), every rank then opens it (POSIX); the other
+    // ranks wait for its layout.
+    const double journal_bytes_per_tile = o.compressed ? 33.0 : 9.0;
     const double t0 = MPI_Wtime();
     if (rank == 0) {
         fs.metadata();
-        fs.write(33.0 * tiles + 65536);
+        fs.client_write(journal_bytes_per_tile * tiles + 65536, 0);
         fs.metadata();
     }
     world.barrier();
-    fs.metadata();  // every rank's open (POSIX, for uncompressed writes and the resume check)
+    fs.metadata();
     world.barrier();
 
-    // Rank 0: the appender of compressed tiles, and the resume journal every
-    // journal_seconds: the appender drained, the journal written (24 + 8 + 1 bytes per tile
-    // recorded), the file covered (an HDF5 open, the superblock written, a close).
+    // Rank 0: the appender of compressed tiles, and a checkpoint every journal_seconds
+    // (explore.cpp `checkpoint`): the appender flushed (its last write waited for), the
+    // journal written (Journal::checkpoint: the range from the first to the last tile
+    // recorded since the last one, in one write per dataset: where the tiles lie, 24 bytes
+    // a tile, their checksums, 8, their flags, 1; with interleaved hand-out that range is
+    // most of the grid), then the file covered (PlacedChunks::cover, rank 0 alone: the undo
+    // log created and its header written, the HDF5 open, its superblock read, logged and
+    // rewritten, the close, the log unlinked: four small operations and four on metadata).
     std::optional<Appender> appender;
-    if (rank == 0 && o.compressed && o.io) appender.emplace(fs);
-    std::uint64_t unjournaled = 0;
+    if (rank == 0 && o.compressed && o.io) appender.emplace(fs, o.append_bytes);
+    std::uint64_t dirty_begin = costs.tiles(), dirty_end = 0;
     double next_journal = MPI_Wtime() + o.journal_seconds;
-    const auto journal = [&] {
-        if (appender) appender->drain();
-        fs.write(33.0 * static_cast<double>(unjournaled) + 4096);
-        if (appender) {
-            fs.metadata();
-            fs.write(4096);
-            fs.metadata();
+    double checkpoint_s = 0;
+    const auto checkpoint = [&](bool cover) {
+        const double begin = MPI_Wtime();
+        if (appender) appender->flush();
+        if (dirty_end > dirty_begin) {
+            const auto n = static_cast<double>(dirty_end - dirty_begin);
+            if (o.compressed) fs.client_write(24 * n, 0);
+            fs.client_write(8 * n, 0);
+            fs.client_write(n, 0);
+            if (cover && appender) {
+                fs.metadata();
+                for (int i = 0; i < 4; ++i) fs.client_write(512);
+                fs.metadata();
+                fs.metadata();
+                fs.metadata();
+            }
         }
-        unjournaled = 0;
+        dirty_begin = costs.tiles();
+        dirty_end = 0;
+        checkpoint_s += MPI_Wtime() - begin;
     };
     // Progress on standard error every tenth of the tiles: long simulations are long.
     std::uint64_t reported = 0;
     std::uint64_t next_mark = costs.tiles() / 10;
     const auto wall_start = std::chrono::steady_clock::now();
+    double copy_s = 0;
     const TilesDone done = [&](std::span<const TileReport> tiles_done, int, std::span<const std::byte> payload) {
         reported += tiles_done.size();
         if (reported >= next_mark && next_mark > 0) {
@@ -513,11 +572,20 @@ int run(int argc, char** argv)
                          MPI_Wtime(), std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
             next_mark += costs.tiles() / 10;
         }
-        if (appender) appender->add(static_cast<double>(payload.size()));
-        unjournaled += tiles_done.size();
+        for (const TileReport& t : tiles_done) {
+            dirty_begin = std::min(dirty_begin, t.tile);
+            dirty_end = std::max(dirty_end, t.tile + 1);
+        }
+        if (appender) {
+            // TileBatch::unpack's copy and ChunkAppender::add's, on rank 0's main thread.
+            const double copy = 2.0 * static_cast<double>(payload.size()) / (o.copy_gbps * 1e9);
+            smpi_execute(copy);
+            copy_s += copy;
+            appender->add(static_cast<double>(payload.size()));
+        }
         if (MPI_Wtime() >= next_journal) {
-            journal();
             next_journal = MPI_Wtime() + o.journal_seconds;
+            checkpoint(true);
         }
     };
     world.barrier();
@@ -544,34 +612,43 @@ int run(int argc, char** argv)
                      r.stats.idle_seconds, r.stats.leader ? 1 : 0);
     }
 
-    // The end (run/explore.cpp): rank 0's last write and the journal, every rank closes
-    // the file, then rank 0 alone makes it the result: every tile indexed where it lies
-    // (CPU, and the index written: two entries of 16 bytes a tile), the attributes, the
-    // close, the rename, the sidecar.
+    // The end (run/explore.cpp): rank 0's last write and the journal (no cover: the finish
+    // follows), every rank closes the file, then rank 0 alone makes it the result
+    // (io/final_result.cpp): the HDF5 open with the undo log (as a cover), every tile
+    // indexed where it lies (--index-us-per-tile of rank 0's CPU a tile, measured by
+    // calibrate.sh, and the index written: two entries of 15 bytes a tile, HDF5's fixed-array
+    // pages of 1024 entries written in a burst at the close), the attributes, the close, the
+    // rename, the undo log unlinked, the sidecar (create, write, close).
     double finish_start = 0;
     if (rank == 0) {
-        if (appender) appender->drain();
-        journal();
+        checkpoint(false);
         finish_start = MPI_Wtime();
     }
     world.barrier();
     if (rank == 0 && o.io) {
-        fs.metadata();  // open
+        fs.metadata();           // the undo log
+        fs.metadata();           // the HDF5 open
+        fs.client_write(512);    // the superblock read and logged
         if (o.compressed) {
             smpi_execute(o.index_us_per_tile * 1e-6 * tiles);
-            fs.write(32.0 * tiles);
+            fs.client_write(30.0 * tiles, 0);
         }
-        fs.write(4096);  // attributes, journal unlinked
-        fs.metadata();   // close
-        fs.metadata();   // rename
-        fs.metadata();   // the sidecar: create, write, close
-        fs.write(1024);
+        fs.client_write(4096);   // attributes, /progress unlinked, the superblock
+        fs.metadata();           // close
+        fs.metadata();           // rename
+        fs.metadata();           // the undo log unlinked
+        fs.metadata();           // the sidecar: create, write, close
+        fs.client_write(1024);
+        fs.metadata();
     }
     world.barrier();
     const double end = MPI_Wtime();
     const double written = appender ? appender->written : 0.0;
+    const double writes = appender ? static_cast<double>(appender->writes) : 0.0;
     const double backlog = appender ? appender->backlog : 0.0;
     const double writer_busy = appender ? appender->busy_s : 0.0;
+    const double held_back = appender ? appender->held_back_s : 0.0;
+    const double peak_ingress = appender ? appender->peak_ingress() : 0.0;
     appender.reset();
 
     // Reductions, not a gather: SMPI's gather to one rank of 4096 waits on its requests one
@@ -599,16 +676,18 @@ int run(int argc, char** argv)
         const double end_to_end = o.startup_seconds + (end - t0);
         const double ideal = total / ranks;
         std::printf("ranks=%d efficiency=%.4f end_to_end=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "
-                    "startup_s=%.6g create_s=%.6g finish_s=%.6g closing_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu "
+                    "startup_s=%.6g create_s=%.6g finish_s=%.6g after_compute_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu "
                     "root_messages=%llu max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f "
                     "root_asked_back=%llu idle_s_per_rank=%.6g reported=%llu compressed=%d payload_bytes=%.6g "
-                    "written_by_root=%.6g writer_busy_s=%.6g writer_backlog_bytes=%.6g\n",
+                    "written_by_root=%.6g root_writes=%.0f writer_busy_s=%.6g writer_backlog_bytes=%.6g root_held_back_s=%.6g "
+                    "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g checkpoint_s=%.6g\n",
                     ranks, ideal / (scheduled - start), ideal / end_to_end, end_to_end, ideal, total, schedule_s,
                     o.startup_seconds, start - t0, end - finish_start, end - scheduled, last_busy - first_idle,
                     static_cast<unsigned long long>(costs.tiles()), static_cast<unsigned long long>(r.stats.requests_in),
                     static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(), ops,
                     r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back), idle / ranks,
-                    static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writer_busy, backlog);
+                    static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writes, writer_busy,
+                    backlog, held_back, peak_ingress, copy_s, checkpoint_s);
         std::fflush(stdout);
     }
     return 0;

@@ -20,7 +20,7 @@ cd "$root"
 reps=${1:-3}
 .ci/install-deps --scale
 cmake --preset release >/dev/null
-cmake --build build/release -j"$(nproc)" --target superball scale_costs >/dev/null
+cmake --build build/release -j"$(nproc)" --target superball scale_costs codec_speed >/dev/null
 if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 superball=$root/build/release/src/superball
 scale_costs=$root/build/release/tests/scale/scale_costs
@@ -67,10 +67,19 @@ predicted() {  # schedule_s of the simulation: NAME JOB RANKS NS_PER_ITERATION
   local line granule write
   line=$("$scale_costs" "$2" "$3" "$out/$1.low.h5" "$NS_PER_POINT" "$4" "$US_PER_TILE" "$out/$1.$3.bin")
   granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' <<<"$line")
-  # Each tile's compression charged as simulate.sh charges it (the real runs compress).
-  write=(--compress-mbps "$(sed -n 's/.* compress_mbps=\([0-9.e+]*\).*/\1/p' <<<"$line")"
-         --compress-ratio "$(sed -n 's/.* compress_ratio=\([0-9.e+]*\).*/\1/p' <<<"$line")")
-  [[ ${write[1]} == 0 ]] && write=(--uncompressed)
+  # Each tile's compression charged as simulate.sh charges it (the real runs compress), and
+  # the payloads of the size the last real run at this rank count stored ($out/real.h5).
+  local codec
+  codec=$("$root/build/release/tests/scale/codec_speed" "$out/real.h5" "$(sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$line")" 2>/dev/null || true)
+  write=(--compress-mbps "$(/usr/bin/python3 -c '
+import re, sys
+m = re.search(r"raw_bytes=(\d+) seconds=(\S+)", sys.argv[1])
+print(f"{int(m.group(1)) / float(m.group(2)) / 1e6:.0f}" if m else 650)' "$codec")" --compress-ratio "$(/usr/bin/python3 -c '
+import sys, h5py
+with h5py.File(sys.argv[1]) as f:
+    d = [f["wall_bounces"], f["outcome"]]
+    print(sum(x.size * x.dtype.itemsize for x in d) / sum(x.id.get_storage_size() for x in d))' "$out/real.h5")")
+  [[ $(sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$line") == 0 ]] && write=(--uncompressed)
   echo "node-0:$3" >"$out/hosts"
   smpirun -np "$3" -platform tests/scale/local.xml -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$1.$3.bin" \
     --node-ranks "$3" --granule "$granule" "${write[@]}" --no-io --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no \
@@ -89,7 +98,7 @@ for c in "${cases[@]}"; do
   seconds=$(computed "$out/$name.low.toml" 1 2>/dev/null)
   mv "$out/real.h5" "$out/$name.low.h5"
   tiles=$("$superball" explore "$out/$name.low.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
-  read -r ns_per_iteration _ < <(/usr/bin/python3 tests/scale/sample_model.py "$out/$name.low.h5" "$seconds" "$tiles" \
+  read -r ns_per_iteration < <(/usr/bin/python3 tests/scale/sample_model.py "$out/$name.low.h5" "$seconds" "$tiles" \
     "$NS_PER_POINT" "$US_PER_TILE" "$NS_PER_ITERATION")
   for n in ${c#*:}; do
     real=$(computed "$job" "$n" 2>"$out/$name.$n.real")
