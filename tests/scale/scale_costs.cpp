@@ -9,7 +9,7 @@
 // makes for RANKS ranks (default_tiling). OUT.bin: "SBCOST01", then u64 tiles, bytes
 // written per point, points; tiles doubles (seconds); tiles u64 (points); tiles u64 (the
 // tiles of a fresh run in the order explore hands them out, job/tiles.hpp handout_order;
-// shared by all simulated ranks). Prints one
+// shared by all simulated ranks; with DONE.bin, only the tiles not in it). Prints one
 // line: tiles, their points, the block granule, total compute, the costliest tile, the ideal
 // time at RANKS ranks, the job's compression level and bytes per count. (How far the job's
 // data compress is measured apart, at full resolution, by chunk_ratio.py: the sample's
@@ -107,8 +107,9 @@ void put(std::ofstream& out, const T& x)
 
 int main(int argc, char** argv)
 {
-    if (argc != 8) {
-        std::fprintf(stderr, "usage: scale_costs JOB.toml RANKS LOWRES.h5 NS_PER_POINT NS_PER_ITERATION US_PER_TILE OUT.bin\n");
+    if (argc != 8 && argc != 9) {
+        std::fprintf(stderr,
+                     "usage: scale_costs JOB.toml RANKS LOWRES.h5 NS_PER_POINT NS_PER_ITERATION US_PER_TILE OUT.bin [DONE.bin]\n");
         return 2;
     }
     try {
@@ -145,13 +146,28 @@ int main(int argc, char** argv)
         // the tiles are handed out in its order.
         const std::uint64_t granule =
             job.compression > 0 ? 1 : std::max<std::uint64_t>(1, job.alignment / (tiling.box(0).points() * count_bytes));
-        std::vector<std::uint64_t> pending(tiling.tiles());
-        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) pending[t] = t;
+        // A resumed run (DONE.bin: the tiles its journal records done, u64 each, as sim_run
+        // --lose-node-at writes them) hands out only the others, in the order a resume does.
+        std::vector<bool> done(tiling.tiles(), false);
+        if (argc == 9) {
+            std::ifstream in(argv[8], std::ios::binary);
+            if (!in) throw std::runtime_error(std::string("cannot read ") + argv[8]);
+            std::uint64_t t = 0;
+            while (in.read(reinterpret_cast<char*>(&t), sizeof t)) {
+                if (t >= tiling.tiles()) throw std::runtime_error(fmt::format("{}: tile {} of {}", argv[8], t, tiling.tiles()));
+                done[t] = true;
+            }
+        }
+        std::vector<std::uint64_t> pending;
+        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
+            if (!done[t]) pending.push_back(t);
+        }
         for (const std::uint64_t t : handout_order(pending, granule, ranks >= interleave_ranks_default)) put(out, t);
         if (!out) throw std::runtime_error(std::string("cannot write ") + argv[7]);
         fmt::print("tiles={} tile_points={} granule={} compute_s={:.6g} costliest_tile_s={:.6g} ideal_s={:.6g} "
-                   "compression={} count_bytes={}\n",
-                   tiling.tiles(), tiling.box(0).points(), granule, total, worst, total / ranks, job.compression, count_bytes);
+                   "compression={} count_bytes={} pending={}\n",
+                   tiling.tiles(), tiling.box(0).points(), granule, total, worst, total / ranks, job.compression, count_bytes,
+                   pending.size());
         return 0;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "scale_costs: %s\n", e.what());

@@ -19,7 +19,7 @@
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
 //       [--uncompressed] [--flush-bytes 6291456] [--journal-seconds 10] [--compress-mbps 650] [--compress-ratio 100]
 //       [--index-us-per-tile 4] [--copy-gbps 10] [--startup-seconds 2] [--no-io] [--serve-every 0.05] [--server-serve-every 0.005]
-//       [--trace] [--trace-bucket 1]
+//       [--trace] [--trace-bucket 1] [--noise SIGMA] [--slow-nodes FRACTION:SPEED] [--seed 1]
 #include <fcntl.h>
 #include <mpi.h>
 #include <smpi/smpi.h>
@@ -75,7 +75,11 @@ public:
         tiles_ = header[0];
         bytes_per_point_ = header[1];
         points_ = header[2];
-        if (size_ != 32 + tiles_ * 24) throw std::runtime_error(path + ": truncated");
+        // The hand-out list holds every tile, or (a resumed run) those not yet done.
+        if (size_ < 32 + tiles_ * 16 || (size_ - 32 - tiles_ * 16) % 8 != 0 || (size_ - 32 - tiles_ * 16) / 8 > tiles_) {
+            throw std::runtime_error(path + ": truncated");
+        }
+        pending_count_ = (size_ - 32 - tiles_ * 16) / 8;
         cost_ = reinterpret_cast<const double*>(bytes + 32);
         tile_points_ = reinterpret_cast<const std::uint64_t*>(bytes + 32 + 8 * tiles_);
         pending_ = reinterpret_cast<const std::uint64_t*>(bytes + 32 + 16 * tiles_);
@@ -89,12 +93,12 @@ public:
     std::uint64_t points() const { return points_; }
     double cost(std::uint64_t t) const { return cost_[t]; }
     std::uint64_t tile_points(std::uint64_t t) const { return tile_points_[t]; }
-    std::span<const std::uint64_t> pending() const { return {pending_, tiles_}; }
+    std::span<const std::uint64_t> pending() const { return {pending_, pending_count_}; }
 
 private:
     void* data_ = nullptr;
     std::size_t size_ = 0;
-    std::uint64_t tiles_ = 0, bytes_per_point_ = 0, points_ = 0;
+    std::uint64_t tiles_ = 0, bytes_per_point_ = 0, points_ = 0, pending_count_ = 0;
     const double* cost_ = nullptr;
     const std::uint64_t* tile_points_ = nullptr;
     const std::uint64_t* pending_ = nullptr;
@@ -126,6 +130,19 @@ struct Options {
     double serve_every = 0.05;     // most compute seconds between two Serve calls (see ModelWork)
     // The same for ranks that serve many (Serve::points below 512: node leaders).
     double server_serve_every = 0.005;
+    // Stresses (simulate.sh --noise, --slow-nodes): each tile's compute cost times a
+    // lognormal factor of mean 1 and this sigma, drawn from the tile's index and the seed (so
+    // the same whichever rank counts it); the nodes whose index a seeded draw puts below
+    // slow_fraction count at slow_speed of the others.
+    double noise_sigma = 0;
+    double slow_fraction = 0;
+    double slow_speed = 1;
+    std::uint64_t seed = 1;
+    // A node lost this many simulated seconds into the compute phase (negative: none): the
+    // MPI job dies with it. Rank 0 then writes the tiles its journal recorded at its last
+    // checkpoint (u64 each) to lost_record, for the resumed run (scale_costs DONE.bin).
+    double lose_node_at = -1;
+    std::string lost_record;
 };
 
 Options parse(int argc, char** argv)
@@ -156,10 +173,26 @@ Options parse(int argc, char** argv)
         else if (a == "--trace-bucket") o.trace_bucket = std::stod(value());
         else if (a == "--serve-every") o.serve_every = std::stod(value());
         else if (a == "--server-serve-every") o.server_serve_every = std::stod(value());
+        else if (a == "--noise") o.noise_sigma = std::stod(value());
+        else if (a == "--slow-nodes") {
+            // FRACTION:SPEED
+            const std::string v = value();
+            const auto colon = v.find(':');
+            if (colon == std::string::npos) throw std::runtime_error("--slow-nodes takes FRACTION:SPEED, not " + v);
+            o.slow_fraction = std::stod(v.substr(0, colon));
+            o.slow_speed = std::stod(v.substr(colon + 1));
+            if (o.slow_fraction < 0 || o.slow_fraction > 1 || o.slow_speed <= 0) {
+                throw std::runtime_error("--slow-nodes: FRACTION in [0, 1] and SPEED > 0, not " + v);
+            }
+        }
+        else if (a == "--seed") o.seed = std::stoull(value());
+        else if (a == "--lose-node-at") o.lose_node_at = std::stod(value());
+        else if (a == "--lost-record") o.lost_record = value();
         else if (o.costs.empty() && a.rfind("--", 0) != 0) o.costs = a;
         else throw std::runtime_error("unknown argument " + a);
     }
     if (o.costs.empty()) throw std::runtime_error("usage: sim_run COSTS.bin [options]");
+    if (o.lose_node_at >= 0 && o.lost_record.empty()) throw std::runtime_error("--lose-node-at needs --lost-record FILE");
     return o;
 }
 
@@ -392,10 +425,40 @@ private:
 // --batch-bytes: the payload of the real message is that many bytes. Uncompressed: as the
 // writer does, tiles buffered until ~6 MiB, a tile that does not follow the last, or a
 // flush, then one write to /wall_bounces and one to /outcome on the writer thread.
+// A uniform draw in [0, 1) from (a, b): splitmix64, so that stresses are reproducible and do
+// not depend on the order SMPI runs the ranks in.
+double uniform(std::uint64_t a, std::uint64_t b)
+{
+    std::uint64_t z = a * 0x9E3779B97F4A7C15ULL + b + 0x632BE59BD9B4E5ULL;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+
+// The stresses' factor on a tile's compute time on `rank`: noise (lognormal, mean 1) times
+// the slowdown of a slow node.
+double stress_factor(const Options& o, std::uint64_t tile, int rank)
+{
+    double f = 1;
+    if (o.noise_sigma > 0) {
+        // Box-Muller from two draws of the tile.
+        const double u1 = std::max(uniform(o.seed, 2 * tile), 1e-300), u2 = uniform(o.seed, 2 * tile + 1);
+        const double z = std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
+        f *= std::exp(o.noise_sigma * z - o.noise_sigma * o.noise_sigma / 2);
+    }
+    if (o.slow_fraction > 0) {
+        const auto node = static_cast<std::uint64_t>(rank / std::max(1, o.schedule.node_ranks));
+        if (uniform(o.seed + 0x51077, node) < o.slow_fraction) f /= o.slow_speed;
+    }
+    return f;
+}
+
 class ModelWork final : public TileWork {
 public:
     ModelWork(const Costs& c, FileSystem& fs, const Options& o, int rank)
-        : costs_(c),
+        : rank_(rank),
+          costs_(c),
           writer_(fs, rank),
           options_(o),
           flush_bytes_(o.flush_bytes),
@@ -410,7 +473,7 @@ public:
         const std::uint64_t points = costs_.tile_points(tile);
         const double raw = static_cast<double>(points * costs_.bytes_per_point());
         const double compress = options_.compressed ? raw / (options_.compress_mbps * 1e6) : 0.0;
-        const double cost = costs_.cost(tile) + compress;
+        const double cost = (costs_.cost(tile) + compress) * stress_factor(options_, tile, rank_);
         // Time since the last tile (waiting, scheduling, writing), by second of the run.
         const double begin = MPI_Wtime();
         if (begin > last_end) {
@@ -484,6 +547,7 @@ private:
         buffered_bytes_ = 0;
     }
 
+    int rank_;
     const Costs& costs_;
     WriterThread writer_;
     const Options& options_;
@@ -510,6 +574,10 @@ int run(int argc, char** argv)
     FileSystem fs(o, rank);
     ModelWork work(costs, fs, o, rank);
     const double tiles = static_cast<double>(costs.tiles());
+    // Rank 0's record of the tiles reported done, and how many of them its journal held at
+    // the last checkpoint (what a resume finds after a crash).
+    std::vector<std::uint64_t> reported_tiles;
+    std::size_t recorded = 0;
 
     // The start (run/explore.cpp, io/partial_file.cpp create_partial): rank 0 creates the
     // partial file (create, the HDF5 objects and the journal's datasets, 33 bytes a tile
@@ -557,6 +625,7 @@ int run(int argc, char** argv)
         }
         dirty_begin = costs.tiles();
         dirty_end = 0;
+        recorded = reported_tiles.size();
         checkpoint_s += MPI_Wtime() - begin;
     };
     // Progress on standard error every tenth of the tiles: long simulations are long.
@@ -575,6 +644,7 @@ int run(int argc, char** argv)
         for (const TileReport& t : tiles_done) {
             dirty_begin = std::min(dirty_begin, t.tile);
             dirty_end = std::max(dirty_end, t.tile + 1);
+            reported_tiles.push_back(t.tile);
         }
         if (appender) {
             // TileBatch::unpack's copy and ChunkAppender::add's, on rank 0's main thread.
@@ -592,7 +662,34 @@ int run(int argc, char** argv)
     const double start = MPI_Wtime();
     work.last_end = start;
     work.bucket = o.trace_bucket;
-    const ScheduleResult r = run_schedule(world, costs.pending(), work, done, [] { return false; }, o.schedule);
+    // A lost node: every rank stops at that time (the job dies; the schedule's own stop
+    // ends the simulation there, and what happens after is not counted).
+    const StopRequested lost = [&] { return o.lose_node_at >= 0 && MPI_Wtime() - start >= o.lose_node_at; };
+    const ScheduleResult r = run_schedule(world, costs.pending(), work, done, lost, o.schedule);
+    if (o.lose_node_at >= 0) {
+        // The work lost: everything counted (and compressed) by the time of the loss less
+        // the work of the tiles the journal recorded.
+        double busy = work.busy;
+        mpi::check(MPI_Allreduce(MPI_IN_PLACE, &busy, 1, MPI_DOUBLE, MPI_SUM, world.get()), "MPI_Allreduce");
+        if (rank == 0) {
+            double kept = 0;
+            for (std::size_t i = 0; i < recorded; ++i) {
+                const std::uint64_t t = reported_tiles[i];
+                const double raw = static_cast<double>(costs.tile_points(t) * costs.bytes_per_point());
+                kept += costs.cost(t) + (o.compressed ? raw / (o.compress_mbps * 1e6) : 0.0);
+            }
+            std::FILE* f = std::fopen(o.lost_record.c_str(), "wb");
+            if (f == nullptr) throw std::runtime_error("cannot write " + o.lost_record);
+            const std::size_t wrote = std::fwrite(reported_tiles.data(), sizeof(std::uint64_t), recorded, f);
+            if (std::fclose(f) != 0 || wrote != recorded) throw std::runtime_error("cannot write " + o.lost_record);
+            std::printf("lost_node_at_s=%.6g lost_at_s=%.6g recorded_tiles=%zu reported_tiles=%zu pending_tiles=%zu "
+                        "work_s=%.6g recorded_work_s=%.6g lost_work_s=%.6g\n",
+                        o.lose_node_at, o.startup_seconds + (MPI_Wtime() - t0), recorded, reported_tiles.size(),
+                        costs.pending().size(), busy, kept, busy - kept);
+            std::fflush(stdout);
+        }
+        return 0;
+    }
     const double scheduled = world.max(MPI_Wtime());
     if (o.trace) {
         // Every rank's time between tiles, summed by second of the run: where the waits are.
@@ -668,7 +765,7 @@ int run(int argc, char** argv)
                                             MPI_SUM);
     if (rank == 0) {
         double total = 0;
-        for (std::uint64_t t = 0; t < costs.tiles(); ++t) total += costs.cost(t);
+        for (const std::uint64_t t : costs.pending()) total += costs.cost(t);  // (every tile, unless resumed)
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
         const double ops = sums[0], given_back = sums[1], idle = sums[2], payload = sums[3];
         // From mpirun starting (the stated start-up) to the result renamed; and the compute

@@ -18,7 +18,25 @@
 # are in OUT/logs/NAME.N.log.
 #
 #   tests/scale/simulate.sh [--ranks "64 256 1024 4096"] [--startup-seconds S] [--tile-points T]
-#                           [--ratio-boxes K] [--out DIR] [--no-build] [JOB.toml...]
+#                           [--ratio-boxes K] [--out DIR] [--no-build]
+#                           [--latency-factor F] [--bandwidth-factor F] [--fs-bandwidth-factor F]
+#                           [--metadata-factor F] [--noise SIGMA] [--slow-nodes FRACTION:SPEED]
+#                           [--lose-node] [--requeue-seconds S]
+#                           [JOB.toml...]
+#
+# Stresses (defaults: none, the platform of tests/scale/cluster.xml): --latency-factor
+# multiplies the latencies of the links between nodes (10: ten times slower), --bandwidth-factor their
+# bandwidths (0.1: ten times slower); --fs-bandwidth-factor multiplies the file system's
+# bandwidth and one client's; --metadata-factor multiplies the file system's cost per
+# operation (create, open, rename and every write's RPC); --noise SIGMA multiplies each tile's
+# compute time by a lognormal factor of mean 1 (0.05: about +-5 %); --slow-nodes 0.05:0.5
+# makes 5 % of the nodes (a seeded draw) count at half speed. The efficiencies stay relative
+# to the unstressed ideal. --lose-node: a node is lost halfway through the ideal time, the
+# MPI job dies with it, is requeued (--requeue-seconds S in the queue, default 0) and resumes
+# from what its journal recorded; the line then adds lost_at_s, lost_work_s (core-seconds
+# counted and lost) and recorded_tiles, and predicted_s / end_to_end are the whole: until the
+# loss, the queue, the resumed run (efficiency: the resumed run's compute phase). A stressed
+# run's logs are NAME.STRESS.N.log.
 #
 # Default: every job of jobs/cluster, OUT = build/scale. --tile-points: run the jobs in tiles
 # of T points whatever they or the default say (the logs are then NAME.tpT.N.log).
@@ -60,6 +78,11 @@ out=$root/build/scale
 build=true
 tile_points=
 ratio_boxes=32
+latency_factor=1 bandwidth_factor=1 fs_bandwidth_factor=1 metadata_factor=1
+stress_args=()
+stress=
+lose_node=false
+requeue=0
 jobs=()
 while (($# > 0)); do
   case $1 in
@@ -67,10 +90,18 @@ while (($# > 0)); do
     --startup-seconds) startup=$2; shift 2 ;;
     --tile-points) tile_points=$2; shift 2 ;;
     --ratio-boxes) ratio_boxes=$2; shift 2 ;;
+    --latency-factor) latency_factor=$2; stress+=.lat$2; shift 2 ;;
+    --bandwidth-factor) bandwidth_factor=$2; stress+=.bw$2; shift 2 ;;
+    --fs-bandwidth-factor) fs_bandwidth_factor=$2; stress+=.fsbw$2; shift 2 ;;
+    --metadata-factor) metadata_factor=$2; stress+=.meta$2; shift 2 ;;
+    --noise) stress_args+=(--noise "$2"); stress+=.noise$2; shift 2 ;;
+    --slow-nodes) stress_args+=(--slow-nodes "$2"); stress+=.slow${2/:/x}; shift 2 ;;
+    --lose-node) lose_node=true; stress+=.lost; shift ;;
+    --requeue-seconds) requeue=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --no-build) build=false; shift ;;
-    -h|--help) sed -n '2,52p' "$0"; exit 0 ;;
-    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --ratio-boxes, --out, --no-build, --help)" >&2; exit 2 ;;
+    -h|--help) sed -n '2,70p' "$0"; exit 0 ;;
+    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --ratio-boxes, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --help)" >&2; exit 2 ;;
     *) jobs+=("$1"); shift ;;
   esac
 done
@@ -88,6 +119,10 @@ superball=$bin/src/superball
 scale_costs=$bin/tests/scale/scale_costs
 mkdir -p "$out/lowres" "$out/costs" "$out/logs" "$out/ratio" "$out/jobs"
 tests/scale/build_sim_run.sh "$out/sim_run"
+# The platform: cluster.xml with the stresses' factors (tests/scale/stress_platform.py).
+platform=$out/platform$stress.xml
+/usr/bin/python3 tests/scale/stress_platform.py tests/scale/cluster.xml "$platform" "$latency_factor" "$bandwidth_factor" \
+  "$fs_bandwidth_factor" "$metadata_factor"
 # The cluster of cluster.xml: 32 ranks a node, consecutive ranks on one node.
 for ((i = 0; i < 128; i++)); do echo "node-$i:32"; done >"$out/hosts"
 
@@ -112,9 +147,9 @@ with open(sys.argv[2], "w") as f:
             f.write(f"[{t}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in job[t].items()))
 EOF
     job=$out/jobs/$name.tp$tile_points.toml
-    label=$name.tp$tile_points
+    label=$name.tp$tile_points$stress
   else
-    label=$name
+    label=$name$stress
   fi
   "$superball" explore "$job" --dry-run >/dev/null
   # 1. The low-resolution sample, computed again only when the job changed (tile_points
@@ -168,16 +203,48 @@ EOF
     serve_every=$(field ideal_s | /usr/bin/python3 -c 'import sys; print(max(0.05, float(sys.stdin.read()) / 2000))')
     # 4. The simulated run.
     start=$SECONDS
-    smpirun -np "$n" -platform tests/scale/cluster.xml -hostfile "$out/hosts" "$out/sim_run" "$costs" \
-      --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" "${write[@]}" --startup-seconds "$startup" \
-      "${smpi[@]}" >>"$log" 2>&1
+    sim() {  # COSTS [more sim_run options]
+      smpirun -np "$n" -platform "$platform" -hostfile "$out/hosts" "$out/sim_run" "$1" \
+        --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" "${write[@]}" \
+        --startup-seconds "$startup" "${stress_args[@]}" "${@:2}" "${smpi[@]}" >>"$log" 2>&1
+    }
+    extra=
+    if $lose_node; then
+      # A node lost halfway through the ideal time: the job dies; it is requeued
+      # (--requeue-seconds in the queue, default 0: the queue's wait is the cluster's) and
+      # resumes from the tiles its journal recorded at the last checkpoint.
+      ideal=$(field ideal_s)
+      at=$(/usr/bin/python3 -c "print(float('$ideal') / 2)")
+      sim "$costs" --lose-node-at "$at" --lost-record "$out/costs/$label.$n.lost"
+      lost=$(grep '^lost_node_at_s=' "$log" | tail -1)
+      [[ -n $lost ]] || { echo "simulate: no lost-node result for $label at $n ranks; see $log" >&2; exit 1; }
+      "$scale_costs" "$job" "$n" "$out/lowres/$name.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs.resumed" \
+        "$out/costs/$label.$n.lost" >>"$log"
+      sim "$costs.resumed"
+      rm -f "$costs.resumed" "$out/costs/$label.$n.lost"
+    else
+      sim "$costs"
+    fi
     echo "simulate: $label at $n ranks took $((SECONDS - start)) s of wall time" >>"$log"
     line=$(grep '^ranks=' "$log" | tail -1)
     [[ -n $line ]] || { echo "simulate: no result for $label at $n ranks; see $log" >&2; exit 1; }
     efficiency=$(sed -n 's/.* efficiency=\([^ ]*\).*/\1/p' <<<"$line")
     end_to_end=$(sed -n 's/.* end_to_end=\([^ ]*\).*/\1/p' <<<"$line")
     predicted=$(sed -n 's/.* predicted_s=\([^ ]*\).*/\1/p' <<<"$line")
-    echo "job=$label ranks=$n tile_points=$points efficiency=$efficiency end_to_end=$end_to_end predicted_s=$predicted"
+    if $lose_node; then
+      # The whole: the first run until the loss, the queue, the resumed run; against the
+      # whole job's ideal. efficiency stays the resumed run's compute phase's.
+      read -r predicted end_to_end extra < <(/usr/bin/python3 - "$lost" "$predicted" "$requeue" "$(field ideal_s)" <<'PYX'
+import sys
+kv = dict(x.split("=") for x in sys.argv[1].split())
+lost_at, resumed, requeue, ideal = float(kv["lost_at_s"]), float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+total = lost_at + requeue + resumed
+print(f"{total:.6g} {ideal / total:.4f} lost_at_s={lost_at:.6g} lost_work_s={float(kv['lost_work_s']):.6g} "
+      f"recorded_tiles={kv['recorded_tiles']} requeue_s={requeue:g}")
+PYX
+      )
+    fi
+    echo "job=$label ranks=$n tile_points=$points efficiency=$efficiency end_to_end=$end_to_end predicted_s=$predicted${extra:+ $extra}"
     rm -f "$costs"
   done
 done

@@ -1,0 +1,35 @@
+#!/usr/bin/python3
+"""The platform of a stressed scaling simulation (tests/scale/simulate.sh): cluster.xml with
+the network's latencies and bandwidths, the file system's bandwidths (its disk's and one
+client's) and its cost per operation multiplied by the given factors.
+
+    platform.py CLUSTER.xml OUT.xml LATENCY_FACTOR BANDWIDTH_FACTOR FS_BANDWIDTH_FACTOR METADATA_FACTOR
+"""
+import re
+import sys
+
+UNITS = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
+
+
+def main():
+    src, dst = sys.argv[1], sys.argv[2]
+    lat, bw, fsbw, meta = (float(x) for x in sys.argv[3:7])
+    x = open(src).read()
+
+    def rate(f):
+        return lambda m: f'{m.group(1)}"{float(m.group(2)) * UNITS[m.group(3)] * f:.6g}Bps"'
+
+    # The links between nodes (bw, lat); the shared memory within a node (loopback_*) stays.
+    x = re.sub(r'(\s(?:bw)=)"([0-9.]+)([kMG]?)Bps"', rate(bw), x)
+    x = re.sub(r'(\s(?:lat)=)"([0-9.]+)(u?)s"',
+               lambda m: f'{m.group(1)}"{float(m.group(2)) * (1e-6 if m.group(3) else 1.0) * lat:.6g}s"', x)
+    # The file system: its disk, one client, the cost of an operation.
+    x = re.sub(r'(\b(?:read|write)_bw=)"([0-9.]+)([kMG]?)Bps"', rate(fsbw), x)
+    x = re.sub(r'(<prop id="client_bw" value=)"([0-9.e+]+)"', lambda m: f'{m.group(1)}"{float(m.group(2)) * fsbw:.6g}"', x)
+    x = re.sub(r'(<prop id="op_latency" value=)"([0-9.e+-]+)"', lambda m: f'{m.group(1)}"{float(m.group(2)) * meta:.6g}"', x)
+    with open(dst, "w") as f:
+        f.write(x)
+
+
+if __name__ == "__main__":
+    main()
