@@ -439,10 +439,13 @@ TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
     std::uint64_t most = 0;
     mpi::check(MPI_Allreduce(&work.heavy_tiles, &most, 1, MPI_UINT64_T, MPI_MAX, world.get()), "MPI_Allreduce");
     if (computing < 2) return;  // nobody to share with
-    // The first block holds the 50 costly tiles; shared fairly, each rank computes 50 / computing
-    // (a margin for the load of this machine, where probes yield the core to other ranks).
-    EXPECT_LE(most, 40u) << "a rank computed " << most << " of the " << n / 8 << " costly tiles; it gave back "
-                         << r.stats.given_back;
+    // The first block (half a rank's share, 50 tiles) holds every costly tile: without tiles
+    // going back one rank would compute all of them. Shared fairly, each computes
+    // heavy / computing; the bound leaves a margin for this machine's load (probes yield the
+    // core to other ranks) and still fails if nothing goes back.
+    const std::uint64_t heavy = n / 8 + (n % 8 != 0 ? 1 : 0);
+    EXPECT_LE(most, heavy * 3 / 4) << "a rank computed " << most << " of the " << heavy << " costly tiles; it gave back "
+                                   << r.stats.given_back;
 }
 
 }  // namespace
