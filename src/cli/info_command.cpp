@@ -48,8 +48,9 @@ Runner add_info_command(CLI::App& app)
             fmt::print("to finish:   superball explore JOB --resume (the same job and output)\n");
         }
         fmt::print("max_bounces: {}\n", info.max_bounces);
-        fmt::print("written by:  superball {} on {} rank{}, {:.2f} s in all\n", info.software_version, info.mpi_ranks,
-                   info.mpi_ranks == 1 ? "" : "s", info.wall_seconds);
+        fmt::print("written by:  superball {} on {} rank{}{}, {:.2f} s in all\n", info.software_version, info.mpi_ranks,
+                   info.mpi_ranks == 1 ? "" : "s", info.threads > 1 ? fmt::format(" of {} threads", info.threads) : "",
+                   info.wall_seconds);
         // Provenance (CF/ACDD attributes), where the file has it.
         for (const auto& [label, text] : {std::pair{"source:", &info.source}, std::pair{"created:", &info.date_created},
                                           std::pair{"build:", &info.build}}) {
