@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <limits>
 #include <mutex>
 #include <random>
@@ -89,12 +91,18 @@ TEST(CountOnThreads, EveryBlockIsLoadedOnceAndFromSeveralThreads)
     const Starts s = random_starts(n, 3);
     std::atomic<std::size_t> loaded{0};
     std::mutex m;
+    std::condition_variable second_thread;
     std::set<std::thread::id> ids;
+    // The first loads wait (up to 10 s) for a second thread to load a block: on a loaded
+    // machine the calling thread could otherwise count every block before the others start
+    // (this failed under ctest beside other jobs), which says nothing about the sharing.
     const LoadStarts load = [&](std::size_t first, std::size_t count, Starts&) {
         loaded += count;
         {
-            const std::lock_guard lock(m);
+            std::unique_lock lock(m);
             ids.insert(std::this_thread::get_id());
+            second_thread.notify_all();
+            second_thread.wait_for(lock, std::chrono::seconds(10), [&] { return ids.size() >= 2; });
         }
         return s.view().subview(first, count);
     };
