@@ -242,8 +242,10 @@ std::vector<std::byte> TileBatch::pack() const
     const std::uint64_t n = tiles();
     std::vector<std::byte> out(8 * (1 + entries.size()) + data.size());
     std::memcpy(out.data(), &n, 8);
-    std::memcpy(out.data() + 8, entries.data(), 8 * entries.size());
-    std::memcpy(out.data() + 8 * (1 + entries.size()), data.data(), data.size());
+    // An empty batch (a worker handing over before it has a tile) has no buffers at all, and
+    // memcpy from a null pointer is undefined even for 0 bytes (UBSan stops on it).
+    if (!entries.empty()) std::memcpy(out.data() + 8, entries.data(), 8 * entries.size());
+    if (!data.empty()) std::memcpy(out.data() + 8 * (1 + entries.size()), data.data(), data.size());
     return out;
 }
 
@@ -255,7 +257,7 @@ TileBatch TileBatch::unpack(std::span<const std::byte> message)
     std::memcpy(&n, message.data(), 8);
     if (n > (message.size() - 8) / (8 * words)) throw std::runtime_error("a batch of tiles shorter than its entries");
     b.entries.resize(n * words);
-    std::memcpy(b.entries.data(), message.data() + 8, 8 * b.entries.size());
+    if (n > 0) std::memcpy(b.entries.data(), message.data() + 8, 8 * b.entries.size());
     std::uint64_t bytes = 0;
     for (std::uint64_t i = 0; i < n; ++i) bytes += b.entries[words * i + 2] + b.entries[words * i + 3];
     const std::size_t at = 8 * (1 + b.entries.size());
