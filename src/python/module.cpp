@@ -152,6 +152,28 @@ private:
     bool contiguous_ = false;
 };
 
+// InputError for the first point (in C order) with a coordinate that is not finite, naming
+// the coordinate, the value and the index. The kernel counts a launch with a non-finite
+// coordinate as invalid (and a physical start that is no launch becomes NaN), so only the
+// invalid points are looked at, found by memchr: checking every coordinate of every point
+// before counting cost count() 15 % of its time on 4e6 launches (perf, check_finite).
+void refuse_non_finite(const std::vector<CoordinateArray>& c, std::span<const std::uint8_t> outcomes)
+{
+    static_assert(static_cast<int>(Outcome::invalid) == 0);
+    const std::uint8_t* const begin = outcomes.data();
+    const std::uint8_t* const end = begin + outcomes.size();
+    for (const std::uint8_t* p = begin; p != end; ++p) {
+        p = static_cast<const std::uint8_t*>(std::memchr(p, 0, static_cast<std::size_t>(end - p)));
+        if (p == nullptr) return;
+        const auto i = static_cast<std::size_t>(p - begin);
+        for (const CoordinateArray& a : c) {
+            double v = 0;
+            a.read(i, 1, &v);
+            a.check_finite(i, {&v, 1});
+        }
+    }
+}
+
 // count(): the package has broadcast the coordinates to one shape (NumPy views) and checked
 // the scalars' types. Returns (wall_bounces uint32, outcome uint8) of that shape.
 py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coordinates, bool physical, double g,
@@ -178,23 +200,15 @@ py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coo
     const bool in_place = !physical && c[0].contiguous() && c[1].contiguous() && c[2].contiguous();
     const LoadStarts load = [&](std::size_t first, std::size_t count, Starts& buffer) -> StartsView {
         if (in_place) {
-            const StartsView v{{c[0].contiguous() + first, count}, {c[1].contiguous() + first, count},
-                               {c[2].contiguous() + first, count}};
-            c[0].check_finite(first, v.xi);
-            c[1].check_finite(first, v.U);
-            c[2].check_finite(first, v.W);
-            return v;
+            return StartsView{{c[0].contiguous() + first, count}, {c[1].contiguous() + first, count},
+                              {c[2].contiguous() + first, count}};
         }
         buffer.resize(count);
         std::vector<double>* columns[] = {&buffer.xi, &buffer.U, &buffer.W};
-        for (std::size_t k = 0; k < 3; ++k) {
-            c[k].read(first, count, columns[k]->data());
-            c[k].check_finite(first, *columns[k]);
-        }
+        for (std::size_t k = 0; k < 3; ++k) c[k].read(first, count, columns[k]->data());
         if (physical) {
             std::vector<double> omega(count);
             c[3].read(first, count, omega.data());
-            c[3].check_finite(first, omega);
             for (std::size_t i = 0; i < count; ++i) {
                 buffer.set(i, canonical_launch({buffer.xi[i], buffer.U[i], buffer.W[i], omega[i] * radius}, g));
             }
@@ -204,6 +218,7 @@ py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coo
     {
         const py::gil_scoped_release release;
         count_on_threads(load, ModelMatrices::of(model), max_bounces, wb, oc, {k, threads});
+        refuse_non_finite(c, oc);
     }
     return py::make_tuple(wall_bounces, outcomes);
 }
