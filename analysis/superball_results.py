@@ -575,6 +575,15 @@ class Result:
         self.job_toml = self._text("job_toml", MAX_JOB_BYTES)
         self._text("job_fingerprint", MAX_JOB_BYTES)
         self._integer("mpi_ranks", 0, 1 << 40)
+        # Provenance (CF/ACDD), in files of builds that record it: optional, as in the C++ reader.
+        self.provenance = {}
+        for name, limit in (("history", MAX_JOB_BYTES), ("source", MAX_TEXT_BYTES),
+                            ("date_created", MAX_TEXT_BYTES), ("build", MAX_TEXT_BYTES)):
+            if name in attrs:
+                self.provenance[name] = self._text(name, limit)
+        for name, high in (("mpi_hosts", 1 << 40), ("threads", 1 << 20)):
+            if name in attrs:
+                self.provenance[name] = self._integer(name, 1, high)
         if self._number("wall_seconds") < 0:
             self.fail(f"attribute wall_seconds = {self._number('wall_seconds')} is negative")
         complete = self._integer("complete", 0, 1) == 1

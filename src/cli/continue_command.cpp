@@ -16,43 +16,21 @@
 #include "options.hpp"
 #include "run/continuation.hpp"
 #include "core/event_curve.hpp"
+#include "job/provenance.hpp"
 
 namespace superball::cli {
 
 namespace {
 
-constexpr int max_period_limit = 8;
-constexpr double default_step = 0.01;
-
+// The flags: those of the library's ContinuationInput, --start as text, the output's.
 struct ContinueOptions {
-    ModelInput model;
-    std::string param;
-    std::optional<double> min, max;
+    ContinuationInput in;
     std::string start;
-    int period = 1;
-    std::int64_t starts = 2000;
-    std::uint64_t seed = 1;
-    bool corner = false;
-    std::optional<double> step;  // default: min(0.01, --max-step)
-    double max_step = 0.05;
-    double min_step = 1e-7;
-    int max_points = 2000;
     std::string format = "csv";
     std::string output;
-    std::string curve;
-    std::optional<double> curve_min, curve_max;
-    double curve_step = 0.005;
-    double curve_max_step = 0.02;
-    int curve_max_points = 400;
 };
 
-std::string parameter_list()
-{
-    std::string s;
-    for (const Parameter p : all_parameters) s += (s.empty() ? "" : ", ") + std::string(name(p));
-    return s;
-}
-
+// "xi,U,W" as three numbers (resolve_continuation checks they are a launch).
 CanonicalState<double> parse_start(const std::string& text)
 {
     std::vector<double> v;
@@ -69,113 +47,17 @@ CanonicalState<double> parse_start(const std::string& text)
         from = comma + 1;
     }
     if (v.size() != 3) throw InputError("--start = " + text + " is not three numbers: accepted xi,U,W, e.g. 0.25,-0.56,-1.36");
-    if (!(v[0] >= 0.0 && v[0] < 1.0 && v[1] < 0.0)) {
-        throw InputError("--start = " + text + " is not a launch toward the wall: accepted 0 <= xi < 1 (0: the corner plane), U < 0");
-    }
     return {v[0], v[1], v[2]};
-}
-
-ContinuationRun::Curves resolve_curves(const ContinueOptions& opt, const ContinuationRun& run)
-{
-    const auto second = parameter_named(opt.curve);
-    if (!second) throw InputError("--curve = " + opt.curve + " is not a coefficient: accepted " + parameter_list());
-    if (!independent(run.parameter, *second)) {
-        throw InputError("--curve = " + opt.curve + " moves a coefficient --param " + opt.param +
-                         " moves too: accepted a coefficient independent of it");
-    }
-    if (!parameter_defined(run.model, *second)) {
-        throw InputError("--curve = " + opt.curve + " sets both surfaces, but the wall's and the floor's " + opt.curve +
-                         " differ: use " + opt.curve + "_wall or " + opt.curve + "_floor");
-    }
-    const std::string range = parameter_range_text(*second);
-    for (const auto& [flag, value] : {std::pair{"--curve-min", opt.curve_min}, std::pair{"--curve-max", opt.curve_max}}) {
-        if (!value) throw InputError(std::string(flag) + " is not set: give the bounds of " + opt.curve + " (accepted " + range + ")");
-        if (!parameter_in_range(*second, *value)) {
-            throw InputError(std::string(flag) + " = " + format_double(*value) + " is out of range: accepted " + range);
-        }
-    }
-    if (!(*opt.curve_min < *opt.curve_max)) {
-        throw InputError("--curve-min = " + format_double(*opt.curve_min) + " is not below --curve-max = " +
-                         format_double(*opt.curve_max));
-    }
-    const double q0 = parameter_value(run.model, *second);
-    if (q0 < *opt.curve_min || q0 > *opt.curve_max) {
-        throw InputError("the start's " + opt.curve + " = " + format_double(q0) + " is outside --curve-min " +
-                         format_double(*opt.curve_min) + " --curve-max " + format_double(*opt.curve_max));
-    }
-    if (!(opt.curve_max_step > 0.0 && std::isfinite(opt.curve_max_step))) {
-        throw InputError("--curve-max-step = " + format_double(opt.curve_max_step) + " is out of range: accepted > 0");
-    }
-    if (!(opt.curve_step > 1e-5 && opt.curve_step <= opt.curve_max_step)) {
-        throw InputError("--curve-step = " + format_double(opt.curve_step) +
-                         " is out of range: accepted 1e-05 < curve-step <= --curve-max-step");
-    }
-    if (opt.curve_max_points < 1) {
-        throw InputError(fmt::format("--curve-max-points = {} is out of range: accepted >= 1", opt.curve_max_points));
-    }
-    EventCurveSettings set;
-    set.min1 = *opt.min;
-    set.max1 = *opt.max;
-    set.min2 = *opt.curve_min;
-    set.max2 = *opt.curve_max;
-    set.initial_step = opt.curve_step;
-    set.max_step = opt.curve_max_step;
-    set.max_points = opt.curve_max_points;
-    return {*second, set};
 }
 
 ContinuationRun resolve(const ContinueOptions& opt)
 {
-    ContinuationRun run;
-    run.model = resolve_model(opt.model, flag_spelling);
-    const auto parameter = parameter_named(opt.param);
-    if (opt.param.empty()) throw InputError("--param is not set: give the coefficient to continue in, one of " + parameter_list());
-    if (!parameter) throw InputError("--param = " + opt.param + " is not a coefficient: accepted " + parameter_list());
-    run.parameter = *parameter;
-    if (!parameter_defined(run.model, run.parameter)) {
-        throw InputError("--param = " + opt.param + " sets both surfaces, but the wall's and the floor's " + opt.param +
-                         " differ: continue in " + opt.param + "_wall or " + opt.param + "_floor");
-    }
-    const std::string range = parameter_range_text(run.parameter);
-    for (const auto& [flag, value] : {std::pair{"--min", opt.min}, std::pair{"--max", opt.max}}) {
-        if (!value) throw InputError(std::string(flag) + " is not set: give the bounds of " + opt.param + " (accepted " + range + ")");
-        if (!parameter_in_range(run.parameter, *value)) {
-            throw InputError(std::string(flag) + " = " + format_double(*value) + " is out of range: accepted " + range);
-        }
-    }
-    if (!(*opt.min < *opt.max)) {
-        throw InputError("--min = " + format_double(*opt.min) + " is not below --max = " + format_double(*opt.max));
-    }
-    const double p0 = parameter_value(run.model, run.parameter);
-    if (p0 < *opt.min || p0 > *opt.max) {
-        throw InputError("the start's " + opt.param + " = " + format_double(p0) + " (from the model flags) is outside --min " +
-                         format_double(*opt.min) + " --max " + format_double(*opt.max));
-    }
-    if (opt.period < 1 || opt.period > max_period_limit) {
-        throw InputError(fmt::format("--period = {} is out of range: accepted 1..{}", opt.period, max_period_limit));
-    }
-    if (opt.starts < 1) throw InputError(fmt::format("--starts = {} is out of range: accepted starts >= 1", opt.starts));
-    if (!(opt.max_step > 0.0 && std::isfinite(opt.max_step))) {
-        throw InputError("--max-step = " + format_double(opt.max_step) + " is out of range: accepted max-step > 0");
-    }
-    const double step = opt.step.value_or(std::min(default_step, opt.max_step));
-    if (!(step > 0.0 && step <= opt.max_step)) {
-        throw InputError("--step = " + format_double(step) + " is out of range: accepted 0 < step <= --max-step (" +
-                         format_double(opt.max_step) + ")");
-    }
-    if (!(opt.min_step > 0.0 && opt.min_step <= step)) {
-        throw InputError("--min-step = " + format_double(opt.min_step) + " is out of range: accepted 0 < min-step <= --step (" +
-                         format_double(step) + ")");
-    }
-    if (opt.max_points < 1) throw InputError(fmt::format("--max-points = {} is out of range: accepted >= 1", opt.max_points));
+    ContinuationInput in = opt.in;
+    if (!opt.start.empty()) in.start = parse_start(opt.start);
+    ContinuationRun run = resolve_continuation(in, flag_spelling);
     if (opt.format != "csv" && opt.format != "json") {
         throw InputError("--format = " + opt.format + " is not a format: accepted csv or json");
     }
-    run.settings = {*opt.min, *opt.max, step, opt.min_step, opt.max_step, opt.max_points};
-    if (!opt.curve.empty()) run.curves = resolve_curves(opt, run);
-    if (!opt.start.empty()) run.start = parse_start(opt.start);
-    run.period = opt.period;
-    run.search = {opt.period, opt.starts, opt.seed, opt.corner};
     return run;
 }
 
@@ -208,8 +90,9 @@ std::string eigenvalue_fields(const std::array<std::complex<double>, 3>& ev)
 }
 
 // Doubles as the shortest text that reads back to the same value (fmt's "{}").
-void write_csv(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, int ranks)
+void write_csv(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, const Provenance& prov)
 {
+    const auto ranks = prov.mpi_ranks;
     const std::vector<ContinuedBranch>& branches = result.branches;
     const std::string p = std::string(name(run.parameter));
     fmt::print(f, "# superball continue: {} from {} to {}; model at the start: {}\n", p, run.settings.min,
@@ -229,6 +112,7 @@ void write_csv(std::FILE* f, const ContinuationResult& result, const Continuatio
                   "# max |G^period(s) - s| at the point followed; bracket: events, width of the final bracket in\n"
                   "# arclength (bounds the error in {})\n",
                p);
+    fmt::print(f, "{}", provenance_comment(prov, "# "));
     fmt::print(f, "branch,period,corner,{},xi,U,W,lambda,ev1_re,ev1_im,ev2_re,ev2_im,ev3_re,ev3_im,stability,event,note,"
                   "residual,arclength,bracket\n",
                p);
@@ -256,8 +140,9 @@ std::string curve_text(const ContinuedCurve& c, const ContinuationResult& result
 }
 
 // With --curve: the event curves in the plane of the two coefficients.
-void write_curves_csv(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, int ranks)
+void write_curves_csv(std::FILE* f, const ContinuationResult& result, const ContinuationRun& run, const Provenance& prov)
 {
+    const auto ranks = prov.mpi_ranks;
     const std::string p = std::string(name(run.parameter));
     const std::string q = std::string(name(run.curves->second));
     const EventCurveSettings& set = run.curves->settings;
@@ -271,6 +156,7 @@ void write_curves_csv(std::FILE* f, const ContinuationResult& result, const Cont
     }
     fmt::print(f, "# each point: an event located on a line across the curve; (xi, U, W), lambda, ev1..3 and stability\n"
                   "# of the cycle there as in the branches' output\n");
+    fmt::print(f, "{}", provenance_comment(prov, "# "));
     fmt::print(f, "curve,branch,event,period,corner,{},{},xi,U,W,lambda,ev1_re,ev1_im,ev2_re,ev2_im,ev3_re,ev3_im,"
                   "stability,note\n",
                p, q);
@@ -385,6 +271,8 @@ int run(const ContinueOptions& opt)
 {
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
+    // For the CSV header: the run as it starts (collective: every rank counts the hosts).
+    const Provenance prov{process_command_line(), utc_now(), world.size(), mpi::host_count(world), 1, ""};
     ContinuationRun cont;
     ContinuationResult result;
     try {
@@ -405,9 +293,9 @@ int run(const ContinueOptions& opt)
         if (opt.format == "json") {
             write_json(f, result, cont, world.size());
         } else if (cont.curves) {
-            write_curves_csv(f, result, cont, world.size());
+            write_curves_csv(f, result, cont, prov);
         } else {
-            write_csv(f, result, cont, world.size());
+            write_csv(f, result, cont, prov);
         }
     });
     return 0;
@@ -447,29 +335,29 @@ Runner add_continue_command(CLI::App& app)
         "Example: superball continue --e 0.9 --alpha 0.99 --param alpha --min 0.95 --max 1 --corner\n"
         "         | analysis/bifurcation_plot.py - -o alpha.png");
     auto opt = std::make_shared<ContinueOptions>();
-    add_model_flags(*sub, opt->model);
-    sub->add_option("--param", opt->param, "coefficient to continue in: " + parameter_list());
-    sub->add_option("--min", opt->min, "lower bound of the parameter");
-    sub->add_option("--max", opt->max, "upper bound of the parameter");
+    add_model_flags(*sub, opt->in.model);
+    sub->add_option("--param", opt->in.param, "coefficient to continue in: " + parameter_list());
+    sub->add_option("--min", opt->in.min, "lower bound of the parameter");
+    sub->add_option("--max", opt->in.max, "upper bound of the parameter");
     sub->add_option("--start", opt->start, "xi,U,W near the cycle to continue (xi = 0: corner plane)");
-    sub->add_option("--period", opt->period, "period k of the cycle(s), 1..8 (without --start: 1..k)")->capture_default_str();
-    sub->add_option("--starts", opt->starts, "Newton starts of the fixed-point search, >= 1")->capture_default_str();
-    sub->add_option("--seed", opt->seed, "seed of the search's starts")->capture_default_str();
-    sub->add_flag("--corner", opt->corner, "the search also looks on the corner plane xi = 0");
-    sub->add_option("--step", opt->step, "initial arclength step, 0 < step <= --max-step (default: 0.01 or --max-step)");
-    sub->add_option("--max-step", opt->max_step, "largest arclength step, >= --step")->capture_default_str();
-    sub->add_option("--min-step", opt->min_step, "smallest step before the branch is given up")->capture_default_str();
-    sub->add_option("--max-points", opt->max_points, "points per direction of a branch, >= 1")->capture_default_str();
+    sub->add_option("--period", opt->in.period, "period k of the cycle(s), 1..8 (without --start: 1..k)")->capture_default_str();
+    sub->add_option("--starts", opt->in.starts, "Newton starts of the fixed-point search, >= 1")->capture_default_str();
+    sub->add_option("--seed", opt->in.seed, "seed of the search's starts")->capture_default_str();
+    sub->add_flag("--corner", opt->in.corner, "the search also looks on the corner plane xi = 0");
+    sub->add_option("--step", opt->in.step, "initial arclength step, 0 < step <= --max-step (default: 0.01 or --max-step)");
+    sub->add_option("--max-step", opt->in.max_step, "largest arclength step, >= --step")->capture_default_str();
+    sub->add_option("--min-step", opt->in.min_step, "smallest step before the branch is given up")->capture_default_str();
+    sub->add_option("--max-points", opt->in.max_points, "points per direction of a branch, >= 1")->capture_default_str();
     sub->add_option("--format", opt->format, "csv or json")->capture_default_str();
     sub->add_option("-o,--output", opt->output, "write to this file instead of standard output");
     const char* curves = "Event curves (two-parameter continuation)";
-    sub->add_option("--curve", opt->curve, "follow every event of the branches as a curve in (--param, this coefficient)")
+    sub->add_option("--curve", opt->in.curve, "follow every event of the branches as a curve in (--param, this coefficient)")
         ->group(curves);
-    sub->add_option("--curve-min", opt->curve_min, "lower bound of the --curve coefficient")->group(curves);
-    sub->add_option("--curve-max", opt->curve_max, "upper bound of the --curve coefficient")->group(curves);
-    sub->add_option("--curve-step", opt->curve_step, "initial step in the plane, > 1e-05")->capture_default_str()->group(curves);
-    sub->add_option("--curve-max-step", opt->curve_max_step, "largest step in the plane")->capture_default_str()->group(curves);
-    sub->add_option("--curve-max-points", opt->curve_max_points, "points per direction of a curve, >= 1")
+    sub->add_option("--curve-min", opt->in.curve_min, "lower bound of the --curve coefficient")->group(curves);
+    sub->add_option("--curve-max", opt->in.curve_max, "upper bound of the --curve coefficient")->group(curves);
+    sub->add_option("--curve-step", opt->in.curve_step, "initial step in the plane, > 1e-05")->capture_default_str()->group(curves);
+    sub->add_option("--curve-max-step", opt->in.curve_max_step, "largest step in the plane")->capture_default_str()->group(curves);
+    sub->add_option("--curve-max-points", opt->in.curve_max_points, "points per direction of a curve, >= 1")
         ->capture_default_str()
         ->group(curves);
     return [opt] { return run(*opt); };

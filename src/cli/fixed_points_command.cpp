@@ -18,8 +18,6 @@ namespace superball::cli {
 
 namespace {
 
-constexpr int max_period_limit = 8;
-
 struct FixedPointOptions {
     ModelInput model;
     int period = 1;
@@ -32,10 +30,7 @@ struct FixedPointOptions {
 
 void validate(const FixedPointOptions& opt)
 {
-    if (opt.period < 1 || opt.period > max_period_limit) {
-        throw InputError(fmt::format("--period = {} is out of range: accepted 1..{}", opt.period, max_period_limit));
-    }
-    if (opt.starts < 1) throw InputError(fmt::format("--starts = {} is out of range: accepted starts >= 1", opt.starts));
+    check_cycle_search({opt.period, opt.starts, opt.seed, opt.corner}, flag_spelling);
     if (opt.format != "table" && opt.format != "json") {
         throw InputError("--format = " + opt.format + " is not a format: accepted table or json");
     }

@@ -1,7 +1,10 @@
 // superball info: what a result or partial file says about itself, validated.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <memory>
+#include <string_view>
+#include <utility>
 
 #include "commands.hpp"
 #include "core/count.hpp"
@@ -45,8 +48,23 @@ Runner add_info_command(CLI::App& app)
             fmt::print("to finish:   superball explore JOB --resume (the same job and output)\n");
         }
         fmt::print("max_bounces: {}\n", info.max_bounces);
-        fmt::print("written by:  superball {} on {} rank{}, {:.2f} s in all\n", info.software_version, info.mpi_ranks,
-                   info.mpi_ranks == 1 ? "" : "s", info.wall_seconds);
+        fmt::print("written by:  superball {} on {} rank{}{}, {:.2f} s in all\n", info.software_version, info.mpi_ranks,
+                   info.mpi_ranks == 1 ? "" : "s", info.threads > 1 ? fmt::format(" of {} threads", info.threads) : "",
+                   info.wall_seconds);
+        // Provenance (CF/ACDD attributes), where the file has it.
+        for (const auto& [label, text] : {std::pair{"source:", &info.source}, std::pair{"created:", &info.date_created},
+                                          std::pair{"build:", &info.build}}) {
+            if (!text->empty()) fmt::print("{:<13}{}\n", label, *text);
+        }
+        if (!info.history.empty()) {
+            fmt::print("history:\n");
+            std::size_t from = 0;
+            while (from < info.history.size()) {
+                const std::size_t end = std::min(info.history.find('\n', from), info.history.size());
+                fmt::print("  {}\n", std::string_view(info.history).substr(from, end - from));
+                from = end + 1;
+            }
+        }
         fmt::print("outcomes{}:\n", h.not_computed ? " (of the points computed so far)" : "");
         const std::uint64_t computed = info.points() - h.not_computed;
         for (int o = 0; o < outcome_count; ++o) {

@@ -24,16 +24,10 @@ struct TrajectoryOptions {
 // Every double is printed with the shortest text that reads back to the same value.
 void write_csv(std::FILE* f, const Trajectory& tr, double radius)
 {
-    fmt::print(f, "event,wall_bounces,t,x,y,u_in,v_in,omega_in,u,v,omega\n");
-    for (const Event& e : tr.events) {
-        fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", name(e.kind), e.wall_bounces, e.t, e.x, e.y, e.before.u,
-                   e.before.v, e.before.W / radius, e.after.u, e.after.v, e.after.W / radius);
-    }
-    // Flight-path samples: same columns, the velocity at the sample on both sides.
-    for (const PathPoint& p : tr.path) {
-        const double omega = tr.events[p.segment].after.W / radius;
-        fmt::print(f, "path,{},{},{},{},{},{},{},{},{},{}\n", tr.events[p.segment].wall_bounces, p.t, p.x, p.y, p.u, p.v,
-                   omega, p.u, p.v, omega);
+    fmt::print(f, "{}\n", trajectory_columns);
+    for (const TrajectoryRow& r : trajectory_rows(tr, radius)) {
+        fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", r.event, r.wall_bounces, r.t, r.x, r.y, r.u_in, r.v_in, r.omega_in,
+                   r.u, r.v, r.omega);
     }
 }
 

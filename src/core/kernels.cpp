@@ -1,6 +1,10 @@
 #include "kernels.hpp"
 
+#include <sched.h>
+
+#include <algorithm>
 #include <cstdlib>
+#include <thread>
 
 #include "count_simd.hpp"
 #include "count_simd_variant.hpp"
@@ -179,6 +183,23 @@ std::string describe(const KernelVariant& k)
 {
     if (k.lanes == 1) return std::string(k.name);
     return std::string(k.name) + " (" + std::string(k.instruction_set) + ", " + std::to_string(k.lanes) + " lanes)";
+}
+
+unsigned usable_cores()
+{
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return static_cast<unsigned>(CPU_COUNT(&set));
+    return std::max(1u, std::thread::hardware_concurrency());
+}
+
+std::string describe(CountKernel k)
+{
+    if (k == scalar_kernel().count) return describe(scalar_kernel());
+    for (const KernelVariant& v : simd_kernels()) {
+        if (v.count == k) return describe(v);
+    }
+    return "a kernel of the caller's";
 }
 
 std::string kernel_report()

@@ -62,6 +62,14 @@ const KernelVariant& select_kernel(std::string_view flag);
 
 // "avx2 (AVX2+FMA, 4 lanes)".
 std::string describe(const KernelVariant& k);
+// describe() of the variant (scalar_kernel() or one of simd_kernels()) whose count is `k`,
+// for the provenance of a run that was handed the function; "a kernel of the caller's"
+// for any other.
+std::string describe(CountKernel k);
+
+// The cores this process may run on (its CPU affinity; else the hardware's threads, at
+// least 1): the default number of counting threads.
+unsigned usable_cores();
 
 // For --version: the kernel in use and the variants this build and processor have, e.g.
 // "counting kernel: avx512 (AVX-512, 8 lanes); compiled in: baseline, avx2, avx512; this

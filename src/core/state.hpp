@@ -52,6 +52,18 @@ inline CanonicalState<double> to_canonical(const PhysicalState<double>& s, doubl
     return {g * s.x / (2.0 * std::fabs(s.u) * s.v), s.u / s.v, s.W / s.v};
 }
 
+// The canonical coordinates of a physical start as count() needs them: those of the
+// launch, or, for a state that is no launch toward the wall, a non-admissible canonical
+// state (NaN) that count() reports as invalid.
+inline CanonicalState<double> canonical_launch(const PhysicalState<double>& s, double g)
+{
+    if (!is_launch(s)) {
+        const double nan = std::nan("");
+        return {nan, nan, nan};
+    }
+    return to_canonical(s, g);
+}
+
 // Canonical -> the physical representative with vertical speed v (any v > 0 is the same
 // launch up to scale).
 inline PhysicalState<double> to_physical(const CanonicalState<double>& c, double g, double v)

@@ -125,7 +125,7 @@ void place(const Extent& box_count, const Extent& tile_shape, std::size_t n, Put
 }  // namespace
 
 PartialLayout create_partial(const std::filesystem::path& path, const Job& job, const Grid& grid, const Tiling& tiling,
-                             int ranks)
+                             const Provenance& run)
 {
     const h5::Id fapl = h5::file_access(job.alignment);
     const h5::Id file = h5::create_file(path, fapl);
@@ -138,7 +138,7 @@ PartialLayout create_partial(const std::filesystem::path& path, const Job& job, 
     }
     create_tiled(file, layout::wall_bounces, count_type(job), tiling, job.compression);
     create_tiled(file, layout::outcome, H5T_STD_U8LE, tiling, job.compression);
-    const std::vector<h5::Id> axes = write_metadata(file, job, grid, layout::kind_partial, {ranks, 0.0, false}, true);
+    const std::vector<h5::Id> axes = write_metadata(file, job, grid, layout::kind_partial, {run, 0.0, false}, true);
     {
         const h5::Id counts = h5::open_dataset(file, layout::wall_bounces);
         const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
@@ -155,11 +155,11 @@ PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& ti
     return layout_of(h5::open_file(path, false), tiling);
 }
 
-double record_partial_run(const std::filesystem::path& path, double seconds, int ranks)
+double record_partial_run(const std::filesystem::path& path, double seconds, const Provenance& run)
 {
     PlacedChunks file(path);
     const double total = h5::read_double_attribute(file.file(), "wall_seconds") + seconds;
-    write_run_figures(file.file(), {ranks, total, false});
+    write_run_figures(file.file(), {run, total, false});
     file.close();
     PlacedChunks::discard_undo(path);
     return total;
@@ -168,7 +168,12 @@ double record_partial_run(const std::filesystem::path& path, double seconds, int
 // ------------------------------------------------------------------------- PartialFile
 
 PartialFile::PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout)
-    : path_(path), comm_(comm), tiling_(std::move(tiling)), layout_(layout), file_(path)
+    : path_(path), comm_(&comm), tiling_(std::move(tiling)), layout_(layout), file_(path)
+{
+}
+
+PartialFile::PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout)
+    : path_(path), comm_(nullptr), tiling_(std::move(tiling)), layout_(layout), file_(path)
 {
 }
 
@@ -176,8 +181,8 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
                                                 std::span<const StoredChunk> stored)
 {
     // Contiguous shares: runs of consecutive tiles are read in one piece.
-    const auto ranks = static_cast<std::uint64_t>(comm_.size());
-    const auto rank = static_cast<std::uint64_t>(comm_.rank());
+    const auto ranks = static_cast<std::uint64_t>(comm_ ? comm_->size() : 1);
+    const auto rank = static_cast<std::uint64_t>(comm_ ? comm_->rank() : 0);
     const std::uint64_t begin = done.size() * rank / ranks, end = done.size() * (rank + 1) / ranks;
     std::vector<std::uint64_t> bad;
     std::vector<std::byte> counts, outcomes;
@@ -214,11 +219,12 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
             i += n;
         }
     }
+    if (!comm_) return bad;
     // Every rank's findings, in tile order (the shares are in order).
     std::vector<double> mine(bad.begin(), bad.end());
-    std::vector<double> all = comm_.gather(mine);
+    std::vector<double> all = comm_->gather(mine);
     std::vector<std::uint64_t> out(all.begin(), all.end());
-    comm_.broadcast(out);
+    comm_->broadcast(out);
     return out;
 }
 
@@ -236,8 +242,10 @@ std::vector<std::byte> TileBatch::pack() const
     const std::uint64_t n = tiles();
     std::vector<std::byte> out(8 * (1 + entries.size()) + data.size());
     std::memcpy(out.data(), &n, 8);
-    std::memcpy(out.data() + 8, entries.data(), 8 * entries.size());
-    std::memcpy(out.data() + 8 * (1 + entries.size()), data.data(), data.size());
+    // An empty batch (a worker handing over before it has a tile) has no buffers at all, and
+    // memcpy from a null pointer is undefined even for 0 bytes (UBSan stops on it).
+    if (!entries.empty()) std::memcpy(out.data() + 8, entries.data(), 8 * entries.size());
+    if (!data.empty()) std::memcpy(out.data() + 8 * (1 + entries.size()), data.data(), data.size());
     return out;
 }
 
@@ -249,7 +257,7 @@ TileBatch TileBatch::unpack(std::span<const std::byte> message)
     std::memcpy(&n, message.data(), 8);
     if (n > (message.size() - 8) / (8 * words)) throw std::runtime_error("a batch of tiles shorter than its entries");
     b.entries.resize(n * words);
-    std::memcpy(b.entries.data(), message.data() + 8, 8 * b.entries.size());
+    if (n > 0) std::memcpy(b.entries.data(), message.data() + 8, 8 * b.entries.size());
     std::uint64_t bytes = 0;
     for (std::uint64_t i = 0; i < n; ++i) bytes += b.entries[words * i + 2] + b.entries[words * i + 3];
     const std::size_t at = 8 * (1 + b.entries.size());

@@ -29,6 +29,7 @@
 
 #include "job/grid.hpp"
 #include "job/job.hpp"
+#include "job/provenance.hpp"
 #include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
 #include "page_buffer.hpp"
@@ -56,23 +57,26 @@ struct PartialLayout {
 };
 
 // Rank 0 only: creates the partial file of `job` at `path` (replacing any file there) for
-// `ranks` ranks, compressed at the job's level unless it is 0, and returns its layout.
-// The coordinate variables and attributes are those of a result; the run's figures
-// (wall_seconds, mpi_ranks) start at zero.
+// the run `run` (its ranks, its provenance), compressed at the job's level unless it is 0,
+// and returns its layout. The coordinate variables and attributes are those of a result;
+// wall_seconds starts at zero.
 PartialLayout create_partial(const std::filesystem::path& path, const Job& job, const Grid& grid, const Tiling& tiling,
-                             int ranks);
+                             const Provenance& run);
 // Rank 0 only: the layout of an existing partial file (validated by ResultReader before):
 // compressed or not as it was created, whatever the job says now.
 PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& tiling);
 // Rank 0 only, with no rank holding the file open: adds a run's seconds to wall_seconds and
-// records its rank count; returns the new wall_seconds. Keeps every byte of the file
-// (chunks appended past HDF5's own end included).
-double record_partial_run(const std::filesystem::path& path, double seconds, int ranks);
+// records the run (its ranks, its line of history); returns the new wall_seconds. Keeps
+// every byte of the file (chunks appended past HDF5's own end included).
+double record_partial_run(const std::filesystem::path& path, double seconds, const Provenance& run);
 
 // The partial file opened by every rank of a run, each on its own descriptor.
 class PartialFile {
 public:
     PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout);
+    // For a run in one process without MPI (run/explore_threads.hpp): its threads share the
+    // one descriptor (positioned reads and writes), and damaged() checks every tile here.
+    PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout);
 
     const Tiling& tiling() const { return tiling_; }
     const PartialLayout& layout() const { return layout_; }
@@ -81,7 +85,7 @@ public:
 
     // Collective: of the tiles `done` (identical on every rank, ascending) with the
     // checksums recorded for them (and, compressed, where they lie), those whose data no
-    // longer match, on every rank. Each rank reads its share.
+    // longer match, on every rank. Each rank reads its share (one process: all).
     std::vector<std::uint64_t> damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
                                        std::span<const StoredChunk> stored);
 
@@ -90,7 +94,7 @@ public:
 
 private:
     std::filesystem::path path_;
-    const mpi::Comm& comm_;
+    const mpi::Comm* comm_;  // nullptr: one process
     Tiling tiling_;
     PartialLayout layout_;
     PosixFile file_;

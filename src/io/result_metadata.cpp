@@ -84,7 +84,11 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
     h5::write_attribute(file, "superball_format", layout::format_version);
     h5::write_text_attribute(file, "Conventions", "CF-1.8");
     h5::write_text_attribute(file, "title", "superball: wall bounces of a superball between a floor and a wall, over a grid of launches");
-    h5::write_text_attribute(file, "source", std::string("superball ") + software_version);
+    // Provenance (CF and ACDD): the software and the run that created the file; history
+    // (write_run_figures) has a line per run.
+    h5::write_text_attribute(file, "source", software_source());
+    h5::write_text_attribute(file, "date_created", run.run.date);
+    h5::write_text_attribute(file, "build", software_build() + (run.run.kernel.empty() ? "" : "; counting kernel " + run.run.kernel));
     // Not "coordinates": that is CF's keyword for auxiliary coordinates, which xarray takes.
     h5::write_attribute(file, "coordinate_system", std::string(name(job.coordinates)));
     h5::write_attribute(file, "axis_names", axis_names);
@@ -140,7 +144,12 @@ void describe_data(hid_t wall_bounces, hid_t outcome, const Job& job, const std:
 
 void write_run_figures(hid_t file, const RunFigures& run)
 {
-    h5::write_attribute(file, "mpi_ranks", run.mpi_ranks);
+    const std::string before = h5::has_attribute(file, "history") ? h5::read_string_attribute(file, "history") : "";
+    // UTF-8 (a command line may name any path), as job_toml.
+    h5::write_attribute(file, "history", append_history(before, history_line(run.run)));
+    h5::write_attribute(file, "mpi_ranks", run.run.mpi_ranks);
+    h5::write_attribute(file, "mpi_hosts", run.run.hosts);
+    h5::write_attribute(file, "threads", run.run.threads);
     h5::write_attribute(file, "wall_seconds", run.wall_seconds);
     h5::write_attribute(file, "complete", std::int64_t{run.complete ? 1 : 0});
 }

@@ -35,19 +35,39 @@ std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
 // A text of a file, for a message: at most 60 characters, with control characters and
 // bytes that are not UTF-8 escaped (\xNN), so that a damaged file's bytes can neither
 // garble a terminal nor make the message unreadable.
+// Length of the UTF-8 sequence at text[i], 0 if none begins there.
+std::size_t utf8_sequence(std::string_view text, std::size_t i)
+{
+    const auto c = static_cast<unsigned char>(text[i]);
+    const std::size_t n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+    bool valid = n > 0 && i + n <= text.size();
+    for (std::size_t k = 1; valid && k < n; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+    return valid ? n : 0;
+}
+
+// Whether `text` is UTF-8 with no control characters but line breaks: text a reader may
+// print as it is.
+bool printable_lines(std::string_view text)
+{
+    for (std::size_t i = 0; i < text.size();) {
+        const std::size_t n = utf8_sequence(text, i);
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (n == 0 || (n == 1 && ((c < 0x20 && c != '\n') || c == 0x7f))) return false;
+        i += n;
+    }
+    return true;
+}
+
 std::string printable(std::string_view text)
 {
     std::string out;
     std::size_t i = 0;
     for (std::size_t shown = 0; i < text.size() && shown < 60; ++shown) {
         const auto c = static_cast<unsigned char>(text[i]);
-        // Length of the UTF-8 sequence c begins, 0 if it begins none.
-        const std::size_t n = c < 0x80 ? 1 : c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
-        bool valid = n > 0 && i + n <= text.size();
-        for (std::size_t k = 1; valid && k < n; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xc0) == 0x80;
+        const std::size_t n = utf8_sequence(text, i);
         if (n == 1 && c >= 0x20 && c != 0x7f) {
             out += static_cast<char>(c);
-        } else if (valid && n > 1) {
+        } else if (n > 1) {
             out.append(text.substr(i, n));
             i += n - 1;
         } else {
@@ -444,6 +464,20 @@ void ResultReader::validate()
     }
     in.job_fingerprint = check.text("job_fingerprint", max_job_bytes);
     in.mpi_ranks = check.integer("mpi_ranks", 0, std::int64_t{1} << 40);
+    // Provenance, in files of superball 0.1.0 from commit-recording builds on: optional.
+    // Printed by info as they are: damaged bytes are refused, not shown.
+    const auto optional_text = [&](const char* key, std::size_t max_bytes) {
+        if (!h5::has_attribute(file_, key)) return std::string();
+        std::string v = check.text(key, max_bytes);
+        if (!printable_lines(v)) check.fail(fmt::format("attribute {} = \"{}\" is not UTF-8 text: the file is damaged", key, printable(v)));
+        return v;
+    };
+    in.history = optional_text("history", max_job_bytes);
+    in.source = optional_text("source", max_text_bytes);
+    in.date_created = optional_text("date_created", max_text_bytes);
+    in.build = optional_text("build", max_text_bytes);
+    if (h5::has_attribute(file_, "mpi_hosts")) in.mpi_hosts = check.integer("mpi_hosts", 1, std::int64_t{1} << 40);
+    if (h5::has_attribute(file_, "threads")) in.threads = check.integer("threads", 1, std::int64_t{1} << 20);
     in.wall_seconds = check.number("wall_seconds");
     if (in.wall_seconds < 0) check.fail(fmt::format("attribute wall_seconds = {} is negative", in.wall_seconds));
     in.complete = check.integer("complete", 0, 1) == 1;

@@ -47,6 +47,11 @@ struct ResultInfo {
     std::string software_version;
     std::int64_t max_bounces = 0;
     std::int64_t mpi_ranks = 0;
+    // Provenance (job/provenance.hpp): CF/ACDD history (a line per run), source, date_created,
+    // build; the last run's hosts and threads per rank. Empty or 0 in files written before
+    // superball recorded them.
+    std::string history, source, date_created, build;
+    std::int64_t mpi_hosts = 0, threads = 0;
     double wall_seconds = 0;
     bool complete = false;                  // a result is complete; a partial file never is
     // Partial files: the tiling and the journal's count; results: one "tile", done.

@@ -76,12 +76,7 @@ Extent Grid::shape() const
 CanonicalState<double> Grid::canonical(const std::vector<double>& c) const
 {
     if (job_.coordinates == Coordinates::canonical) return {c[0], c[1], c[2]};
-    const PhysicalState<double> s{c[0], c[1], c[2], c[3] * job_.frame.radius};
-    if (!is_launch(s)) {
-        constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-        return {nan, nan, nan};
-    }
-    return to_canonical(s, job_.frame.g);
+    return canonical_launch({c[0], c[1], c[2], c[3] * job_.frame.radius}, job_.frame.g);
 }
 
 void Grid::starts(const Box& box, Starts& out) const

@@ -299,4 +299,11 @@ OwnedComm OwnedComm::dup(const Comm& c)
     return OwnedComm(out);
 }
 
+int host_count(const Comm& c)
+{
+    const OwnedComm node = OwnedComm::split_shared(c, c.rank());
+    const std::uint64_t first_of_node = node.view().rank() == 0 ? 1 : 0;
+    return static_cast<int>(c.sum({first_of_node}).front());
+}
+
 }  // namespace superball::mpi

@@ -144,4 +144,8 @@ private:
     MPI_Comm comm_ = MPI_COMM_NULL;
 };
 
+// The number of hosts (shared-memory nodes, MPI_Comm_split_type) the ranks of `c` run on,
+// on every rank. Collective.
+int host_count(const Comm& c);
+
 }  // namespace superball::mpi

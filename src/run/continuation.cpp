@@ -1,6 +1,7 @@
 #include "continuation.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/input.hpp"
@@ -185,8 +186,22 @@ std::pair<std::size_t, std::optional<EventCurve>> get_curve(Reader& r)
     return {index, std::move(c)};
 }
 
+// One process without MPI (the Python module): what the collectives below come to on a
+// single rank.
+struct Alone {
+    int rank() const { return 0; }
+    int size() const { return 1; }
+    bool is_root() const { return true; }
+    void broadcast(std::vector<double>&) const {}
+    std::vector<double> gather(const std::vector<double>& mine) const { return mine; }
+};
+
+std::vector<Cycle> search(const ContinuationRun& run, const mpi::Comm& comm) { return find_cycles(run.model, run.search, comm); }
+std::vector<Cycle> search(const ContinuationRun& run, const Alone&) { return find_cycles(run.model, run.search); }
+
 // The cycles to start from, the same on every rank.
-std::vector<Cycle> starts(const ContinuationRun& run, const mpi::Comm& comm)
+template <class Team>
+std::vector<Cycle> starts(const ContinuationRun& run, const Team& comm)
 {
     const ModelMatrices m = ModelMatrices::of(run.model);
     if (run.start) {
@@ -194,16 +209,16 @@ std::vector<Cycle> starts(const ContinuationRun& run, const mpi::Comm& comm)
         const auto point = newton_cycle(*run.start, m, run.period, domain);
         const auto cycle = point ? make_cycle(*point, m, run.period, domain) : std::nullopt;
         if (!cycle) {
-            throw InputError("--start = " + format_double(run.start->xi) + "," + format_double(run.start->U) + "," +
+            throw InputError(run.start_key + " = " + format_double(run.start->xi) + "," + format_double(run.start->U) + "," +
                              format_double(run.start->W) + ": Newton's method finds no cycle of period " +
                              std::to_string(run.period) + " from there" +
                              (domain == Domain::corner ? " on the corner plane" : "") +
-                             " (superball fixed-points lists the cycles)");
+                             " (fixed-points lists the cycles)");
         }
         return {*cycle};
     }
     Writer w;
-    for (const Cycle& c : find_cycles(run.model, run.search, comm)) put_cycle(w, c);
+    for (const Cycle& c : search(run, comm)) put_cycle(w, c);
     comm.broadcast(w.data());
     std::vector<Cycle> cycles;
     Reader r(w.data());
@@ -238,8 +253,9 @@ bool curve_event(Event e)
 
 // The event curves of the branches (on rank 0), computed curve i on rank i mod size. Every
 // rank needs the branches: rank 0 sends them.
+template <class Team>
 std::vector<ContinuedCurve> continue_curves(const std::vector<ContinuedBranch>& branches, const ContinuationRun& run,
-                                            const mpi::Comm& comm)
+                                            const Team& comm)
 {
     Writer all_branches;
     for (std::size_t i = 0; i < branches.size(); ++i) put_branch(all_branches, i, branches[i].branch);
@@ -271,9 +287,8 @@ std::vector<ContinuedCurve> continue_curves(const std::vector<ContinuedBranch>& 
     return jobs;
 }
 
-}  // namespace
-
-ContinuationResult continue_branches(const ContinuationRun& run, const mpi::Comm& comm)
+template <class Team>
+ContinuationResult continue_with(const ContinuationRun& run, const Team& comm)
 {
     const std::vector<Cycle> cycles = starts(run, comm);
     Writer mine;
@@ -305,5 +320,124 @@ ContinuationResult continue_branches(const ContinuationRun& run, const mpi::Comm
     if (run.curves) result.curves = continue_curves(result.branches, run, comm);
     return result;
 }
+
+// The bounds `lo`, `hi` of coefficient p (keys lo_key, hi_key), checked: set, in range,
+// ordered, and around the start's value p0 (from the model).
+void check_bounds(Parameter p, const std::optional<double>& lo, const std::optional<double>& hi, const std::string& lo_key,
+                  const std::string& hi_key, const std::string& p_name, double p0, const std::string& p0_origin)
+{
+    const std::string range = parameter_range_text(p);
+    for (const auto& [key, value] : {std::pair{&lo_key, lo}, std::pair{&hi_key, hi}}) {
+        if (!value) throw InputError(*key + " is not set: give the bounds of " + p_name + " (accepted " + range + ")");
+        if (!parameter_in_range(p, *value)) {
+            throw InputError(*key + " = " + format_double(*value) + " is out of range: accepted " + range);
+        }
+    }
+    if (!(*lo < *hi)) throw InputError(lo_key + " = " + format_double(*lo) + " is not below " + hi_key + " = " + format_double(*hi));
+    if (p0 < *lo || p0 > *hi) {
+        throw InputError("the start's " + p_name + " = " + format_double(p0) + p0_origin + " is outside " + lo_key + " " +
+                         format_double(*lo) + " " + hi_key + " " + format_double(*hi));
+    }
+}
+
+ContinuationRun::Curves resolve_curves(const ContinuationInput& in, const ContinuationRun& run, const KeySpelling& spell)
+{
+    const std::string key = spell("curve");
+    const auto second = parameter_named(in.curve);
+    if (!second) throw InputError(key + " = " + in.curve + " is not a coefficient: accepted " + parameter_list());
+    if (!independent(run.parameter, *second)) {
+        throw InputError(key + " = " + in.curve + " moves a coefficient " + spell("param") + " " + in.param +
+                         " moves too: accepted a coefficient independent of it");
+    }
+    if (!parameter_defined(run.model, *second)) {
+        throw InputError(key + " = " + in.curve + " sets both surfaces, but the wall's and the floor's " + in.curve +
+                         " differ: use " + in.curve + "_wall or " + in.curve + "_floor");
+    }
+    check_bounds(*second, in.curve_min, in.curve_max, spell("curve_min"), spell("curve_max"), in.curve,
+                 parameter_value(run.model, *second), "");
+    if (!(in.curve_max_step > 0.0 && std::isfinite(in.curve_max_step))) {
+        throw InputError(spell("curve_max_step") + " = " + format_double(in.curve_max_step) + " is out of range: accepted > 0");
+    }
+    if (!(in.curve_step > 1e-5 && in.curve_step <= in.curve_max_step)) {
+        throw InputError(spell("curve_step") + " = " + format_double(in.curve_step) + " is out of range: accepted 1e-05 < " +
+                         spell("curve_step") + " <= " + spell("curve_max_step"));
+    }
+    if (in.curve_max_points < 1) {
+        throw InputError(spell("curve_max_points") + " = " + std::to_string(in.curve_max_points) +
+                         " is out of range: accepted >= 1");
+    }
+    EventCurveSettings set;
+    set.min1 = run.settings.min;
+    set.max1 = run.settings.max;
+    set.min2 = *in.curve_min;
+    set.max2 = *in.curve_max;
+    set.initial_step = in.curve_step;
+    set.max_step = in.curve_max_step;
+    set.max_points = in.curve_max_points;
+    return {*second, set};
+}
+
+}  // namespace
+
+std::string parameter_list()
+{
+    std::string s;
+    for (const Parameter p : all_parameters) s += (s.empty() ? "" : ", ") + std::string(name(p));
+    return s;
+}
+
+ContinuationRun resolve_continuation(const ContinuationInput& in, const KeySpelling& spell)
+{
+    constexpr double default_step = 0.01;
+    ContinuationRun run;
+    run.model = resolve_model(in.model, spell);
+    const std::string param = spell("param");
+    if (in.param.empty()) throw InputError(param + " is not set: give the coefficient to continue in, one of " + parameter_list());
+    const auto parameter = parameter_named(in.param);
+    if (!parameter) throw InputError(param + " = " + in.param + " is not a coefficient: accepted " + parameter_list());
+    run.parameter = *parameter;
+    if (!parameter_defined(run.model, run.parameter)) {
+        throw InputError(param + " = " + in.param + " sets both surfaces, but the wall's and the floor's " + in.param +
+                         " differ: continue in " + in.param + "_wall or " + in.param + "_floor");
+    }
+    check_bounds(run.parameter, in.min, in.max, spell("min"), spell("max"), in.param,
+                 parameter_value(run.model, run.parameter), " (from the model)");
+    check_cycle_search({in.period, in.starts, in.seed, in.corner}, spell);
+    const std::string max_step = spell("max_step"), step_key = spell("step");
+    if (!(in.max_step > 0.0 && std::isfinite(in.max_step))) {
+        throw InputError(max_step + " = " + format_double(in.max_step) + " is out of range: accepted " + max_step + " > 0");
+    }
+    const double step = in.step.value_or(std::min(default_step, in.max_step));
+    if (!(step > 0.0 && step <= in.max_step)) {
+        throw InputError(step_key + " = " + format_double(step) + " is out of range: accepted 0 < " + step_key + " <= " +
+                         max_step + " (" + format_double(in.max_step) + ")");
+    }
+    if (!(in.min_step > 0.0 && in.min_step <= step)) {
+        throw InputError(spell("min_step") + " = " + format_double(in.min_step) + " is out of range: accepted 0 < " +
+                         spell("min_step") + " <= " + step_key + " (" + format_double(step) + ")");
+    }
+    if (in.max_points < 1) {
+        throw InputError(spell("max_points") + " = " + std::to_string(in.max_points) + " is out of range: accepted >= 1");
+    }
+    run.settings = {*in.min, *in.max, step, in.min_step, in.max_step, in.max_points};
+    if (!in.curve.empty()) run.curves = resolve_curves(in, run, spell);
+    if (in.start) {
+        const CanonicalState<double>& s = *in.start;
+        if (!(s.xi >= 0.0 && s.xi < 1.0 && s.U < 0.0 && std::isfinite(s.W))) {
+            throw InputError(spell("start") + " = " + format_double(s.xi) + "," + format_double(s.U) + "," +
+                             format_double(s.W) +
+                             " is not a launch toward the wall: accepted 0 <= xi < 1 (0: the corner plane), U < 0");
+        }
+        run.start = s;
+        run.start_key = spell("start");
+    }
+    run.period = in.period;
+    run.search = {in.period, in.starts, in.seed, in.corner};
+    return run;
+}
+
+ContinuationResult continue_branches(const ContinuationRun& run, const mpi::Comm& comm) { return continue_with(run, comm); }
+
+ContinuationResult continue_branches(const ContinuationRun& run) { return continue_with(run, Alone{}); }
 
 }  // namespace superball

@@ -1,6 +1,7 @@
 #include "cycles.hpp"
 
 #include <algorithm>
+#include <string>
 
 namespace superball {
 
@@ -56,18 +57,42 @@ std::vector<Hit> unpack(const std::vector<double>& data)
     return hits;
 }
 
+// The distinct cycles of every rank's hits.
+std::vector<Cycle> cycles_of(const ModelMatrices& m, const std::vector<double>& all)
+{
+    std::vector<Cycle> found;
+    for (const Hit& h : unpack(all)) {
+        if (auto c = make_cycle(h.point, m, h.k, h.domain)) found.push_back(std::move(*c));
+    }
+    return distinct_cycles(found);
+}
+
 }  // namespace
+
+void check_cycle_search(const CycleSearch& search, const KeySpelling& spell)
+{
+    if (search.max_period < 1 || search.max_period > max_cycle_period) {
+        throw InputError(spell("period") + " = " + std::to_string(search.max_period) + " is out of range: accepted 1.." +
+                         std::to_string(max_cycle_period));
+    }
+    if (search.starts < 1) {
+        throw InputError(spell("starts") + " = " + std::to_string(search.starts) + " is out of range: accepted " +
+                         spell("starts") + " >= 1");
+    }
+}
 
 std::vector<Cycle> find_cycles(const Model& model, const CycleSearch& search, const mpi::Comm& comm)
 {
     const ModelMatrices m = ModelMatrices::of(model);
     const std::vector<double> all = comm.gather(search_share(m, search, comm.rank(), comm.size()));
     if (!comm.is_root()) return {};
-    std::vector<Cycle> found;
-    for (const Hit& h : unpack(all)) {
-        if (auto c = make_cycle(h.point, m, h.k, h.domain)) found.push_back(std::move(*c));
-    }
-    return distinct_cycles(found);
+    return cycles_of(m, all);
+}
+
+std::vector<Cycle> find_cycles(const Model& model, const CycleSearch& search)
+{
+    const ModelMatrices m = ModelMatrices::of(model);
+    return cycles_of(m, search_share(m, search, 0, 1));
 }
 
 }  // namespace superball

@@ -23,6 +23,8 @@
 #include "io/posix_file.hpp"
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
+#include "job/provenance.hpp"
+#include "run/explore_work.hpp"
 #include "run/refine.hpp"
 #include "run/tile_counter.hpp"
 #include "superball/version.hpp"
@@ -216,13 +218,16 @@ Decision decide(const ExploreSettings& s, const fs::path& out, const Job& job)
     return check_writable(out, {Verdict::fresh, s.resume ? "no run to resume at " + out.string() + ": starting a new run" : ""});
 }
 
-// Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
+}  // namespace
+
 double peak_rss_mib()
 {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
+
+namespace {
 
 void broadcast(const mpi::Comm& comm, PartialLayout& l)
 {
@@ -234,7 +239,7 @@ void broadcast(const mpi::Comm& comm, PartialLayout& l)
 
 // Counts tiles and hands them on: compressed, into a batch that goes to rank 0 with the
 // rank's reports (TileWork::flush); uncompressed, to the rank's TileWriter.
-class Work final : public TileWork {
+class Work final : public ExploreWork {
 public:
     Work(const Job& job, const Grid& grid, const Tiling& tiling, const PartialLayout& layout, TileWriter* writer, CountKernel k)
         : job_(job),
@@ -311,6 +316,13 @@ public:
         histogram[0] += n - bit0 - bit1 + both;
     }
 
+    std::vector<std::uint64_t> tallies() const override
+    {
+        std::vector<std::uint64_t> t = histogram;
+        t.insert(t.end(), {counted, points});
+        return t;
+    }
+
     std::vector<std::uint64_t> histogram = std::vector<std::uint64_t>(outcome_count, 0);
     std::uint64_t counted = 0;  // points counted by the kernel (fewer than the tiles' with refinement)
     std::uint64_t points = 0;
@@ -349,6 +361,18 @@ double seconds_since(std::chrono::steady_clock::time_point t)
 
 }  // namespace
 
+std::unique_ptr<ExploreWork> make_explore_work(const Job& job, const Grid& grid, const Tiling& tiling,
+                                               const PartialLayout& layout, TileWriter* writer, CountKernel kernel)
+{
+    return std::make_unique<Work>(job, grid, tiling, layout, writer, kernel);
+}
+
+Provenance run_provenance(const ExploreSettings& settings, int ranks, int hosts, int threads)
+{
+    return {settings.command.empty() ? process_command_line() : settings.command, utc_now(), ranks, hosts, threads,
+            describe(settings.kernel)};
+}
+
 fs::path output_path(const Job& job, const ExploreSettings& settings)
 {
     fs::path out = settings.output.empty() ? fs::path(job.output) : settings.output;
@@ -356,20 +380,20 @@ fs::path output_path(const Job& job, const ExploreSettings& settings)
     return out;
 }
 
-ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm)
+namespace {
+
+// decide(), which never throws: whatever goes wrong, every rank must hear the verdict.
+Decision decide_or_refuse(const ExploreSettings& settings, const fs::path& out, const Job& job)
 {
-    const fs::path out = output_path(job, settings);
-    Decision d;
-    if (comm.is_root()) {
-        // Whatever goes wrong here, every rank must hear the verdict.
-        try {
-            d = decide(settings, out, job);
-        } catch (const std::exception& e) {
-            d = refuse("cannot decide what to do with " + out.string() + ": " + e.what());
-        }
+    try {
+        return decide(settings, out, job);
+    } catch (const std::exception& e) {
+        return refuse("cannot decide what to do with " + out.string() + ": " + e.what());
     }
-    d.verdict = static_cast<Verdict>(comm.broadcast(static_cast<std::int64_t>(d.verdict)));
-    comm.broadcast(d.message);
+}
+
+ExplorePlan plan_of(const Decision& d, const fs::path& out)
+{
     if (d.verdict == Verdict::refuse) throw InputError(d.message);
     const PlanMode mode = d.verdict == Verdict::fresh ? PlanMode::fresh
                           : d.verdict == Verdict::resume ? PlanMode::resume
@@ -377,11 +401,30 @@ ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const 
     return {mode, out, d.message};
 }
 
+}  // namespace
+
+ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm)
+{
+    const fs::path out = output_path(job, settings);
+    Decision d;
+    if (comm.is_root()) d = decide_or_refuse(settings, out, job);
+    d.verdict = static_cast<Verdict>(comm.broadcast(static_cast<std::int64_t>(d.verdict)));
+    comm.broadcast(d.message);
+    return plan_of(d, out);
+}
+
+ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings)
+{
+    const fs::path out = output_path(job, settings);
+    return plan_of(decide_or_refuse(settings, out, job), out);
+}
+
 RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm, RunObserver& observer,
                        const StopRequested& stop)
 {
     const auto started = std::chrono::steady_clock::now();
     const ExplorePlan plan = plan_explore(job, settings, comm);
+    const Provenance provenance = run_provenance(settings, comm.size(), mpi::host_count(comm), 1);
     const fs::path partial = layout::partial_path(plan.output);
     RunSummary summary;
     summary.output = plan.output;
@@ -406,7 +449,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
             if (plan.mode == PlanMode::fresh) {
                 const Tiling tiling = default_tiling(job, comm.size());
                 tile_shape = tiling.tile_shape();
-                layout = create_partial(partial, job, grid, tiling, comm.size());
+                layout = create_partial(partial, job, grid, tiling, provenance);
                 journal.done.assign(tiling.tiles(), 0);
                 journal.checksums.assign(tiling.tiles(), 0);
             } else {
@@ -563,11 +606,11 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
         try {
             const double seconds = seconds_since(started);
             if (r.interrupted) {
-                record_partial_run(partial, seconds, comm.size());
+                record_partial_run(partial, seconds, provenance);
             } else {
                 observer.finishing();
                 finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, record->tiles(),
-                                       {comm.size(), earlier_seconds + seconds, true});
+                                       {provenance, earlier_seconds + seconds, true});
             }
         } catch (const std::exception& e) {
             ok = 0;
@@ -588,10 +631,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
         comm.broadcast(summary.sidecar_note);
     }
 
-    std::vector<std::uint64_t> totals = work.histogram;
-    totals.push_back(work.counted);  // summed with the histogram: one reduction
-    totals.push_back(work.points);
-    totals = comm.sum(totals);
+    std::vector<std::uint64_t> totals = comm.sum(work.tallies());  // with the histogram: one reduction
     summary.points_this_run = totals.back();
     totals.pop_back();
     summary.points_counted = totals.back();

@@ -19,6 +19,7 @@
 
 #include "core/kernels.hpp"
 #include "job/job.hpp"
+#include "job/provenance.hpp"
 #include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
 #include "run/progress.hpp"
@@ -37,6 +38,9 @@ struct ExploreSettings {
     // From this many ranks on, tiles are handed out interleaved (job/tiles.hpp,
     // handout_order); tests set 1 to interleave at any rank count.
     int interleave_ranks = interleave_ranks_default;
+    // For the result's history (job/provenance.hpp): the command or call that ran the job;
+    // empty: this process's command line.
+    std::string command{};
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]
@@ -59,6 +63,13 @@ struct ExplorePlan {
 // superball file (never replaced, even with --overwrite), it belongs to another job or
 // version, or it cannot be written.
 ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm);
+// The same decision for a run in this process alone (run/explore_threads.hpp: no MPI).
+ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings);
+
+// The provenance of a run of `settings` starting now (job/provenance.hpp): settings.command
+// (else this process's command line), the time, `ranks` on `hosts` with `threads` counting
+// threads each, and the kernel.
+Provenance run_provenance(const ExploreSettings& settings, int ranks, int hosts, int threads);
 
 struct RunSummary {
     std::filesystem::path output;

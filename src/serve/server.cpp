@@ -19,9 +19,11 @@
 #include <sstream>
 #include <thread>
 
+#include "core/kernels.hpp"
 #include "core/report.hpp"
 #include "core/trajectory.hpp"
 #include "io/hdf5.hpp"
+#include "job/provenance.hpp"
 #include "layers.hpp"
 #include "pool.hpp"
 #include "region.hpp"
@@ -49,14 +51,6 @@ constexpr std::uint64_t tile_size = 256;
 
 // The client left: nothing to answer.
 struct ClientGone {};
-
-unsigned usable_cores()
-{
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return static_cast<unsigned>(CPU_COUNT(&set));
-    return std::max(1u, std::thread::hardware_concurrency());
-}
 
 std::string address_text(const sockaddr_storage& a)
 {
@@ -296,7 +290,7 @@ private:
             handle(req, res, view_keys(true), [&](Query& q) { api_region(req, q, res); });
         });
         http_.Get("/api/job", [this](const httplib::Request& req, httplib::Response& res) {
-            handle(req, res, keys({view_keys(true), {"output"}}), [&](Query& q) { api_job(q, res); });
+            handle(req, res, keys({view_keys(true), {"output"}}), [&](Query& q) { api_job(req, q, res); });
         });
         http_.Get("/api/legend", [this](const httplib::Request& req, httplib::Response& res) {
             handle(req, res, colouring_keys(), [&](Query& q) {
@@ -422,14 +416,17 @@ private:
         res.set_header("Server-Timing", timing("count", start, counted) + ", " + timing("json", counted, Clock::now()));
     }
 
-    void api_job(Query& q, httplib::Response& res)
+    void api_job(const httplib::Request& req, Query& q, httplib::Response& res)
     {
         Limits l = settings_.limits;
         l.max_bounces = std::numeric_limits<std::uint32_t>::max();  // the job runs elsewhere
         const View v = parse_view(q, l, true);
         const std::string output = q.text("output").value_or("results/view.h5");
         if (output.empty()) throw RequestError(400, "output = \"\" is empty: accepted a file path");
-        const std::string text = job_toml(v, output);
+        // Where the job comes from: this server (its command line) and the request.
+        const Provenance exported{process_command_line() + " (GET " + req.target + ")", utc_now(), 1, 1,
+                                  static_cast<std::int64_t>(pool_.threads()), ""};
+        const std::string text = job_toml(v, output, provenance_comment(exported, "# "));
         try {
             parse_job(text, "the exported job");  // what explore will say about it
         } catch (const InputError& e) {

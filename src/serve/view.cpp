@@ -146,13 +146,15 @@ View tile_view(const View& window, int z, std::int64_t tx, std::int64_t ty, std:
     return v;
 }
 
-std::string job_toml(const View& v, std::string_view output)
+std::string job_toml(const View& v, std::string_view output, std::string_view comment)
 {
     const auto name = [](int k) { return std::string(axis_names[static_cast<std::size_t>(k)]); };
     std::string t = "# A view of superball serve: " + name(v.plane.x) + " across, " + name(v.plane.y) + " up, at " +
                     name(v.plane.fixed) + " = " + format_double(v.fixed) + ".\n";
     t += "# Run it with: mpirun -n RANKS superball explore THIS.toml\n";
-    t += "#          or: sbatch -n RANKS -t HH:MM:SS jobs/slurm/explore.sbatch THIS.toml\n\n[model]\n";
+    t += "#          or: sbatch -n RANKS -t HH:MM:SS jobs/slurm/explore.sbatch THIS.toml\n";
+    t += comment;
+    t += "\n[model]\n";
     const std::pair<const char*, const std::optional<double>*> model[] = {
         {"e", &v.model_input.e},           {"alpha", &v.model_input.alpha},         {"e_wall", &v.model_input.e_wall},
         {"alpha_wall", &v.model_input.alpha_wall}, {"e_floor", &v.model_input.e_floor}, {"alpha_floor", &v.model_input.alpha_floor}};

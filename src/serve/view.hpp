@@ -62,8 +62,9 @@ View parse_view(Query& q, const Limits& limits, bool sizes);
 // RequestError when double precision cannot tell the samples apart.
 View tile_view(const View& window, int z, std::int64_t tx, std::int64_t ty, std::uint64_t n);
 
-// The view as a job file for `superball explore` (output = `output`, left out if empty).
-std::string job_toml(const View& v, std::string_view output);
+// The view as a job file for `superball explore` (output = `output`, left out if empty);
+// `comment` (lines beginning with "# ": the export's provenance) after the header.
+std::string job_toml(const View& v, std::string_view output, std::string_view comment = {});
 
 // The job of job_toml(v, ""), parsed by parse_job: what explore would compute for v.
 Job job_of(const View& v);

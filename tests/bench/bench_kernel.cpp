@@ -8,6 +8,9 @@
 // e = alpha = 0.9. The context line "superball" names the variants.
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -119,6 +122,44 @@ void BM_scalar_loop(benchmark::State& state)
     state.counters["total_wall_bounces"] = static_cast<double>(total);
 }
 
+// The launches of the file `path`: n doubles of xi, then n of U, then n of W (native byte
+// order), as tests/bench/python_count.py writes them.
+Starts read_launches(const char* path)
+{
+    std::FILE* f = std::fopen(path, "rb");
+    if (!f) throw std::runtime_error(std::string("cannot read ") + path);
+    std::vector<double> all;
+    double buf[4096];
+    std::size_t got = 0;
+    while ((got = std::fread(buf, sizeof(double), 4096, f)) > 0) all.insert(all.end(), buf, buf + got);
+    std::fclose(f);
+    const std::size_t n = all.size() / 3;
+    Starts s;
+    s.xi.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n));
+    s.U.assign(all.begin() + static_cast<std::ptrdiff_t>(n), all.begin() + static_cast<std::ptrdiff_t>(2 * n));
+    s.W.assign(all.begin() + static_cast<std::ptrdiff_t>(2 * n), all.begin() + static_cast<std::ptrdiff_t>(3 * n));
+    return s;
+}
+
+// The bare vectorised kernel on `launches`, split in equal contiguous parts among the
+// benchmark's threads, each counting its part in one call (e = alpha = 0.9, max_bounces
+// 1000): what the Python module's count() is measured against (tests/bench/python_count.py).
+void BM_count_launches(benchmark::State& state, const Starts& launches)
+{
+    const auto threads = static_cast<std::size_t>(state.threads());
+    const auto me = static_cast<std::size_t>(state.thread_index());
+    const std::size_t first = launches.size() * me / threads, last = launches.size() * (me + 1) / threads;
+    const StartsView part = launches.view().subview(first, last - first);
+    std::vector<std::uint32_t> wb(part.size());
+    std::vector<std::uint8_t> oc(part.size());
+    for (auto _ : state) {
+        best_kernel().count(part, slice_model, 1000, wb, oc);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * part.size()));
+    state.SetLabel(describe(best_kernel()));
+}
+
 }  // namespace
 
 // The kernels by name: BM_count_slice/<kernel>/<n> for the scalar kernel and every
@@ -147,6 +188,14 @@ int main(int argc, char** argv)
             ->UseRealTime();
     }
     benchmark::RegisterBenchmark("BM_scalar_loop/8192", BM_scalar_loop)->Unit(benchmark::kMillisecond)->UseRealTime();
+    // BM_count_launches/threads:1 and :2, when SUPERBALL_BENCH_LAUNCHES names a file of launches.
+    Starts launches;
+    if (const char* path = std::getenv("SUPERBALL_BENCH_LAUNCHES"); path != nullptr && *path != '\0') {
+        launches = read_launches(path);
+        benchmark::RegisterBenchmark("BM_count_launches", [&launches](benchmark::State& state) {
+            BM_count_launches(state, launches);
+        })->Threads(1)->Threads(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    }
     benchmark::AddCustomContext("superball", kernel_report());
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

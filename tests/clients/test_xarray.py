@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """xarray reads superball's results as netCDF-4/CF, with each of its engines and no
 options: the dimensions and coordinate values of the file's axes, the data equal to
-h5py's, units and long names, outcome flags, fixed coordinates as scalar coordinates and
-the coordinate system among the attributes. On results computed by the binary under test:
+h5py's, units and long names, outcome flags, fixed coordinates as scalar coordinates, and
+among the attributes the coordinate system and the provenance (history, source with the
+commit, date_created, build). On results computed by the binary under test:
 a canonical slice, a volume, a physical slice and a slice swept over alpha.
 
 Needs Debian's python3-xarray, python3-h5netcdf and python3-netcdf4
@@ -28,6 +29,8 @@ except ImportError as e:  # a failure, not a skip: the test command installs the
     raise SystemExit(f"test_xarray: {e}; install the clients with .ci/install-deps --clients")
 
 ENGINES = (None, "h5netcdf", "netcdf4")  # None: xarray's own choice
+# The provenance (CF and ACDD attributes) every result carries, as `superball info` prints it.
+PROVENANCE = ("history", "source", "date_created", "build")
 UNITS = {"xi": "1", "U": "1", "W": "1", "x": "m", "u": "m/s", "v": "m/s", "omega": "rad/s", "alpha": "1", "e": "1"}
 
 
@@ -42,7 +45,12 @@ def h5_view(path):
             "wall_bounces": f["wall_bounces"][()],
             "outcome": f["outcome"][()],
             "coordinate_system": str(f.attrs["coordinate_system"]),
+            "provenance": {k: text(f.attrs[k]) for k in PROVENANCE},
         }
+
+
+def text(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
 
 
 class Xarray(unittest.TestCase):
@@ -98,6 +106,14 @@ class Xarray(unittest.TestCase):
                 self.assertEqual(float(point.coords[name]), value)
             self.assertEqual(ds.attrs.get("coordinate_system"), ref["coordinate_system"])
             self.assertEqual(ds.attrs.get("Conventions"), "CF-1.8")
+            # The provenance, as text a script prints: which program and commit, when, by which command.
+            for key, value in ref["provenance"].items():
+                self.assertIsInstance(ds.attrs.get(key), str, key)
+                self.assertEqual(ds.attrs[key], value, key)
+            self.assertRegex(ds.attrs["source"], r"^superball \S+ \(git ([0-9a-f]{12}|unknown)(, dirty)?\)$")
+            self.assertRegex(ds.attrs["date_created"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+            self.assertTrue(ds.attrs["history"].startswith(ds.attrs["date_created"] + " "), ds.attrs["history"])
+            self.assertIn(" explore ", ds.attrs["history"])
             return {"dims": dict(ds.sizes), "coords": {n: ds.coords[n].values for n in ds.coords}}
 
     def test_every_engine_reads_every_kind_of_result(self):

@@ -207,6 +207,31 @@ class Explore(unittest.TestCase):
                 self.assertEqual(info.returncode, 0, info.stderr)
                 self.assertRegex(info.stdout, r"complete: +no \(0 of \d+ tiles done\)")
 
+    def test_provenance(self):
+        """history (UTC time, the command line, the software, ranks and hosts), source with the
+        commit, date_created and build are in the result; superball info prints them."""
+        job = self.write_job(job_text(CANONICAL_2D), "prov.toml")
+        out = self.path("prov.h5")
+        self.explore(job, out, 2)
+        with h5py.File(out, "r") as f:
+            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        self.assertRegex(attrs["date_created"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+        self.assertRegex(attrs["source"], r"^superball \d+\.\d+\.\d+ \(git ([0-9a-f]{12}|unknown)(, dirty)?\)$")
+        self.assertIn("(kernels: ", attrs["build"])
+        self.assertIn("; counting kernel ", attrs["build"])
+        history = attrs["history"]
+        self.assertEqual(history.count("\n"), 0, history)  # one run, one line
+        self.assertTrue(history.startswith(attrs["date_created"] + " "), history)
+        self.assertIn(f"superball explore {job} -o {out}", history)
+        self.assertIn(attrs["source"] + "; 2 MPI ranks on 1 host, 1 thread each; kernel ", history)
+        self.assertEqual((attrs["mpi_ranks"], attrs["mpi_hosts"], attrs["threads"]), (2, 1, 1))
+        info = subprocess.run([SUPERBALL, "info", out], capture_output=True, text=True, timeout=30)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertIn("source:      " + attrs["source"], info.stdout)
+        self.assertIn("created:     " + attrs["date_created"], info.stdout)
+        self.assertIn("build:       " + attrs["build"], info.stdout)
+        self.assertIn("history:\n  " + history + "\n", info.stdout)
+
     def test_uncompressed(self):
         job = self.write_job(job_text(CANONICAL_2D, run="max_bounces = 1000\ncompression = 0"))
         out = self.path("raw.h5")

@@ -107,6 +107,9 @@ void write_box(hid_t d, hid_t memory_type, const Box& box, const void* values)
     h5::check(H5Dwrite(d, memory_type, memory, space, H5P_DEFAULT, values), "H5Dwrite");
 }
 
+// The run recorded in the templates' provenance attributes.
+const Provenance template_run{"fuzz_result", "2026-01-01T00:00:00Z", 1, 1, 1, "scalar"};
+
 // A complete result as io/final_result.cpp leaves it (written here through HDF5's filters):
 // coordinate variables, attributes, the data in compressed chunks.
 void write_result(const fs::path& path, const char* text)
@@ -115,7 +118,7 @@ void write_result(const fs::path& path, const char* text)
     const Grid grid(job);
     const Extent shape = grid.shape();
     const h5::Id file = h5::create_file(path, h5::file_access(0));
-    const std::vector<h5::Id> axes = write_metadata(file, job, grid, layout::kind_result, {1, 0.25, true}, true);
+    const std::vector<h5::Id> axes = write_metadata(file, job, grid, layout::kind_result, {template_run, 0.25, true}, true);
     const Extent chunk = default_tile_shape(shape, 64);
     const auto create = [&](const char* name, hid_t type) {
         const h5::Id space = h5::simple_space(to_hsize(shape));
@@ -146,7 +149,7 @@ void write_partial(const fs::path& path, const char* text, bool compressed)
     job.compression = compressed ? 4 : 0;
     const Grid grid(job);
     const Tiling tiling(grid.shape(), default_tile_shape(grid.shape(), 48));
-    const PartialLayout layout = create_partial(path, job, grid, tiling, 1);
+    const PartialLayout layout = create_partial(path, job, grid, tiling, template_run);
     std::vector<std::uint8_t> done(tiling.tiles(), 0);
     std::vector<std::uint64_t> sums(tiling.tiles(), 0);
     std::vector<std::uint64_t> stored(3 * tiling.tiles(), 0);

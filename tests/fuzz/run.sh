@@ -26,7 +26,7 @@ job_sources=(src/job/job.cpp src/job/job_parse.cpp src/job/spelling.cpp src/core
 # What ResultReader needs, and the writers of its templates. HDF5 itself is Debian's, not
 # instrumented: coverage guides the fuzzer through our validation, not HDF5's parser.
 result_sources=(src/io/result_reader.cpp src/io/hdf5.cpp src/io/layout.cpp src/io/partial_file.cpp src/io/posix_file.cpp src/io/page_buffer.cpp src/io/placed_chunks.cpp
-                src/io/chunk_codec.cpp src/io/stored_tiles.cpp
+                src/io/chunk_codec.cpp src/io/stored_tiles.cpp src/job/provenance.cpp "$out/generated/git_revision.cpp"
                 src/io/result_metadata.cpp src/mpi/mpi.cpp src/job/grid.cpp src/job/tiles.cpp src/core/count.cpp
                 src/core/boundary_planes.cpp src/core/dynamics.cpp)
 # toml_assert.hpp: see there (toml++ 3.3.0 preconditions on the current character are
@@ -38,7 +38,8 @@ result_sources=(src/io/result_reader.cpp src/io/hdf5.cpp src/io/layout.cpp src/i
 # no __builtin_unreachable of its own, so no other check is lost.
 flags=(-std=c++20 -g -O1 -fno-omit-frame-pointer -ffp-contract=off -DTOML_HEADER_ONLY=1 -I"$root/src"
        -include "$root/tests/fuzz/toml_assert.hpp"
-       -fsanitize=fuzzer,address,undefined -fno-sanitize=unreachable -fno-sanitize-recover=all)
+       -fsanitize=fuzzer,address,undefined -fno-sanitize=unreachable -fno-sanitize-recover=all
+       '-DSUPERBALL_BUILD_DESCRIPTION="fuzz build"')
 
 # The version header CMake generates, for the result writers.
 version=$(sed -n 's/^project(superball VERSION \([0-9.]*\).*/\1/p' "$root/CMakeLists.txt")
@@ -47,6 +48,8 @@ sed "s/@PROJECT_VERSION@/$version/" "$root/src/version.hpp.in" >"$out/generated/
 cmp -s "$out/generated/superball/version.hpp.tmp" "$out/generated/superball/version.hpp" ||
   mv "$out/generated/superball/version.hpp.tmp" "$out/generated/superball/version.hpp"
 rm -f "$out/generated/superball/version.hpp.tmp"
+# The git commit the provenance attributes name (job/provenance.hpp), as the CMake build records it.
+cmake -DSOURCE_DIR="$root" -DOUTPUT="$out/generated/git_revision.cpp" -P "$root/cmake/git_revision.cmake"
 # shellcheck disable=SC2207
 hdf5=($(pkg-config --cflags hdf5-openmpi libxxhash) -I/usr/include/eigen3 -I"$out/generated")
 hdf5_libs=($(pkg-config --libs hdf5-openmpi libxxhash libdeflate) -lhdf5_hl -lfmt $(mpicxx --showme:link))

@@ -18,6 +18,7 @@
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
+#include "job/provenance.hpp"
 #include "mpi/mpi.hpp"
 #include "run/explore.hpp"
 #include "run/refine.hpp"
@@ -174,7 +175,9 @@ TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
     const StopRequested stop = [&] {
         return world.is_root() && tally.start.tiles > 0 && ++polls > tally.start.tiles / 10;
     };
-    const RunSummary first = run_explore(job, settings(out), world, tally, stop);
+    ExploreSettings first_settings = settings(out);
+    first_settings.command = "first run";
+    const RunSummary first = run_explore(job, first_settings, world, tally, stop);
     EXPECT_TRUE(first.interrupted);
     EXPECT_FALSE(first.complete);
     if (world.is_root()) {
@@ -182,6 +185,14 @@ TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
         ASSERT_TRUE(fs::exists(layout::partial_path(out)));
         const ResultReader partial(layout::partial_path(out));
         EXPECT_EQ(partial.info().kind, FileKind::partial);
+        // Provenance: the run that made the file, recorded once although it wrote its
+        // figures at the start and at the stop.
+        EXPECT_EQ(partial.info().history.rfind(partial.info().date_created + " first run [", 0), 0u) << partial.info().history;
+        EXPECT_EQ(partial.info().history.find('\n'), std::string::npos) << partial.info().history;
+        EXPECT_EQ(partial.info().source, software_source());
+        EXPECT_EQ(partial.info().mpi_ranks, world.size());
+        EXPECT_GE(partial.info().mpi_hosts, 1);
+        EXPECT_EQ(partial.info().threads, 1);
         EXPECT_GT(partial.info().tiles_done, 0u);
         EXPECT_LT(partial.info().tiles_done, partial.info().tiles);
         EXPECT_TRUE(partial.damaged_tiles().empty());
@@ -190,10 +201,20 @@ TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
     Tally refused;
     EXPECT_THROW(run_explore(job, settings(out), world, refused, never), InputError);
     Tally again;
-    const RunSummary second = run_explore(job, settings(out, true, false, scalar_kernel().count), world, again, never);
+    ExploreSettings resumed = settings(out, true, false, scalar_kernel().count);
+    resumed.command = "second run";
+    const RunSummary second = run_explore(job, resumed, world, again, never);
     EXPECT_TRUE(second.complete);
     EXPECT_LT(second.points_this_run, job.points());  // only the tiles not done
     if (world.is_root()) {
+        // The resume's line follows the first run's; date_created stays the first run's.
+        const ResultInfo info = ResultReader(out).info();
+        const std::size_t newline = info.history.find('\n');
+        ASSERT_NE(newline, std::string::npos) << info.history;
+        EXPECT_EQ(info.history.rfind(info.date_created + " first run [", 0), 0u) << info.history;
+        EXPECT_NE(info.history.find(" second run [", newline), std::string::npos) << info.history;
+        EXPECT_NE(info.history.find("kernel scalar]", newline), std::string::npos) << info.history;
+        EXPECT_EQ(info.history.find('\n', newline + 1), std::string::npos) << info.history;
         EXPECT_GT(again.start.tiles_done, 0u);
         EXPECT_EQ(again.start.tiles_done + again.tiles, again.start.tiles);
         const Data got = read_result(out);

@@ -136,6 +136,11 @@ class ApiTest(unittest.TestCase):
                 out = self.path(f"plane{k}.h5")
                 status, _, job = self.server.get("/api/job?" + query(**params, output=out))
                 self.assertEqual(status, 200, job)
+                # Provenance of the export: the server, the request, the software.
+                text = job.decode()
+                self.assertRegex(text, r"(?m)^# history: \d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ .*superball.* serve.*\(GET /api/job\?")
+                self.assertRegex(text, r"(?m)^# source: superball \d+\.\d+\.\d+ \(git ")
+                self.assertRegex(text, r"(?m)^# build: ")
                 job_path = self.path(f"plane{k}.toml")
                 with open(job_path, "wb") as f:
                     f.write(job)

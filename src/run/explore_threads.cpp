@@ -1,0 +1,239 @@
+#include "explore_threads.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "io/final_result.hpp"
+#include "io/layout.hpp"
+#include "io/partial_file.hpp"
+#include "io/placed_chunks.hpp"
+#include "io/posix_file.hpp"
+#include "io/result_metadata.hpp"
+#include "io/result_reader.hpp"
+#include "job/grid.hpp"
+#include "run/explore_work.hpp"
+#include "run/threads.hpp"
+
+namespace superball {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// Counts `pending` on one thread per work: each takes the next `granule` tiles (an
+// alignment unit of an uncompressed file's tiles, so that a thread's writer joins them into
+// one write; else one tile) until none is left or a stop is asked for, and hands its tiles
+// to `done` (one call at a time) at least every `report_seconds` and when its work says so.
+// Returns whether the run was stopped with tiles left undone.
+bool count_tiles(std::span<const std::uint64_t> pending, std::span<const std::unique_ptr<ExploreWork>> works,
+                 std::uint64_t granule, double report_seconds, const std::function<void(Flushed)>& done,
+                 const StopRequested& stop)
+{
+    std::atomic<std::size_t> next{0}, computed{0};
+    std::atomic<bool> stopping{false};
+    std::mutex m;
+    const auto hand_over = [&](TileWork& w) {
+        Flushed f = w.flush();
+        if (f.reports.empty()) return;
+        const std::lock_guard lock(m);
+        done(std::move(f));
+    };
+    run_on_threads(static_cast<unsigned>(works.size()), [&](unsigned i) {
+        TileWork& w = *works[i];
+        auto reported = std::chrono::steady_clock::now();
+        bool last = false;
+        // A thread that fails (a write, say) stops the others at their next tile.
+        struct StopOthers {
+            std::atomic<bool>& stopping;
+            ~StopOthers()
+            {
+                if (std::uncaught_exceptions() > 0) stopping = true;
+            }
+        } stop_others{stopping};
+        while (!last) {
+            const std::size_t first = next.fetch_add(granule);
+            last = first >= pending.size();
+            for (std::size_t k = first; k < std::min<std::size_t>(first + granule, pending.size()); ++k) {
+                // Only the calling thread asks: a Python signal handler runs on no other.
+                if (i == 0 && stop && stop()) stopping = true;
+                if (stopping) {
+                    last = true;
+                    break;
+                }
+                w.compute(pending[k], Serve{});
+                ++computed;
+                if (w.should_flush() || seconds_since(reported) >= report_seconds) {
+                    hand_over(w);
+                    reported = std::chrono::steady_clock::now();
+                }
+            }
+        }
+        hand_over(w);
+    });
+    return computed.load() < pending.size();
+}
+
+}  // namespace
+
+RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, unsigned threads, RunObserver& observer,
+                               const StopRequested& stop)
+{
+    const auto started = std::chrono::steady_clock::now();
+    if (threads == 0) threads = usable_cores();
+    const ExplorePlan plan = plan_explore(job, settings);
+    const Provenance provenance = run_provenance(settings, 1, 1, static_cast<int>(threads));
+    const fs::path partial = layout::partial_path(plan.output);
+    RunSummary summary;
+    summary.output = plan.output;
+    summary.outcomes.assign(outcome_count, 0);
+    if (plan.mode == PlanMode::complete) {
+        observer.started({plan.output, plan.note, 1, job.points(), 0, 0, 0, 0});
+        summary.complete = summary.nothing_to_do = true;
+        return summary;
+    }
+
+    // The partial file and its journal, as run_explore makes or reads them; the tiling of a
+    // new file is the one `mpirun -n THREADS` would choose.
+    const Grid grid(job);
+    Extent tile_shape;
+    PartialLayout layout;
+    TileJournal journal;
+    double earlier_seconds = 0;
+    try {
+        if (plan.mode == PlanMode::fresh) {
+            const Tiling tiling = default_tiling(job, static_cast<int>(threads));
+            tile_shape = tiling.tile_shape();
+            layout = create_partial(partial, job, grid, tiling, provenance);
+            journal.done.assign(tiling.tiles(), 0);
+            journal.checksums.assign(tiling.tiles(), 0);
+        } else {
+            const ResultReader reader(partial);
+            tile_shape = reader.info().tile_shape;
+            layout = partial_layout(partial, Tiling(grid.shape(), tile_shape));
+            journal = {reader.tiles_done(), reader.tile_checksums(), reader.tile_stored()};
+            earlier_seconds = reader.info().wall_seconds;
+        }
+    } catch (const std::exception& e) {
+        throw RunError(fmt::format("{} {} failed ({}){}", plan.mode == PlanMode::fresh ? "creating" : "reading",
+                                   partial.string(), e.what(), free_space_note(partial)));
+    }
+    const Tiling tiling(grid.shape(), tile_shape);
+    PartialFile file(partial, tiling, layout);
+    std::vector<std::uint64_t> done_tiles, sums, pending;
+    std::vector<StoredChunk> stored;
+    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
+        if (journal.done[t] == 0) {
+            pending.push_back(t);
+            continue;
+        }
+        done_tiles.push_back(t);
+        sums.push_back(journal.checksums[t]);
+        if (layout.compressed) stored.push_back(journal.stored[t]);
+    }
+    if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums, stored); !bad.empty()) {
+        file.close();
+        throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
+                                     "written with them; refusing to resume onto it: overwrite to start again, or write "
+                                     "elsewhere",
+                                     partial.string(), bad.size(), done_tiles.size(), bad.front()));
+    }
+    RunStart start{plan.output, plan.note, 1, job.points(), tiling.tiles(), tiling.box(0).points(), done_tiles.size(), 0};
+    for (const std::uint64_t t : done_tiles) start.points_done += tiling.box(t).points();
+    observer.started(start);
+
+    // The writer side, as rank 0's: the journal, and one appender of compressed tiles (or,
+    // uncompressed, a writer per thread at the tiles' own offsets).
+    Journal record(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds));
+    std::optional<ChunkAppender> appender;
+    if (layout.compressed) appender.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
+    std::vector<std::optional<TileWriter>> writers(threads);
+    std::vector<std::unique_ptr<ExploreWork>> works;
+    for (std::optional<TileWriter>& w : writers) {
+        if (!layout.compressed) w.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
+        works.push_back(make_explore_work(job, grid, tiling, layout, w ? &*w : nullptr, settings.kernel));
+    }
+    const auto recorded = [&](std::span<const AppendedTile> tiles) {
+        record.record(tiles);
+        std::uint64_t points = 0;
+        for (const AppendedTile& a : tiles) points += tiling.box(a.tile).points();
+        if (!tiles.empty()) observer.tiles_done(tiles.size(), points);
+    };
+    const auto checkpoint = [&] {
+        if (appender) recorded(appender->flush());
+        if (record.checkpoint(true) && appender) PlacedChunks::cover(partial);
+    };
+    const auto on_done = [&](Flushed f) {
+        if (appender) {
+            appender->add(TileBatch::unpack(f.payload));
+            recorded(appender->written());
+        } else {
+            record.record(f.reports);
+            std::uint64_t points = 0;
+            for (const TileReport& r : f.reports) points += tiling.box(r.tile).points();
+            observer.tiles_done(f.reports.size(), points);
+        }
+        if (record.due()) checkpoint();
+    };
+    const std::uint64_t granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    const auto compute_start = std::chrono::steady_clock::now();
+    const bool interrupted = count_tiles(pending, works, granule, ScheduleSettings{}.report_seconds, on_done, stop);
+    const auto compute_end = std::chrono::steady_clock::now();
+    summary.compute_seconds = std::chrono::duration<double>(compute_end - compute_start).count();
+    observer.computed(summary.compute_seconds);
+
+    FinishReport finish;
+    std::string step = "recording the last tiles in";
+    try {
+        if (interrupted) {
+            checkpoint();
+        } else {
+            if (appender) recorded(appender->flush());
+            record.checkpoint(true);
+        }
+        file.close();
+        const double seconds = seconds_since(started);
+        if (interrupted) {
+            step = "recording the run in";
+            record_partial_run(partial, seconds, provenance);
+        } else {
+            step = "finishing the result from";
+            observer.finishing();
+            finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, record.tiles(),
+                                   {provenance, earlier_seconds + seconds, true});
+        }
+    } catch (const std::exception& e) {
+        throw RunError(fmt::format("{} {} failed: {}", step, partial.string(), e.what()));
+    }
+    if (!interrupted) {
+        summary.finish_seconds = seconds_since(compute_end);
+        summary.raw_bytes = finish.raw_bytes;
+        summary.result_bytes = finish.file_bytes;
+        summary.sidecar_note = finish.sidecar_note;
+    }
+    std::vector<std::uint64_t> totals(outcome_count + 2, 0);
+    for (const auto& w : works) {
+        const std::vector<std::uint64_t> t = w->tallies();
+        for (std::size_t k = 0; k < totals.size(); ++k) totals[k] += t[k];
+    }
+    summary.points_this_run = totals[outcome_count + 1];
+    summary.points_counted = totals[outcome_count];
+    summary.outcomes.assign(totals.begin(), totals.begin() + outcome_count);
+    summary.peak_rss_mib = peak_rss_mib();
+    summary.interrupted = interrupted;
+    summary.complete = !interrupted;
+    return summary;
+}
+
+}  // namespace superball

@@ -1,0 +1,35 @@
+// The counting side of an explore run, shared by run_explore (one per MPI rank) and
+// run_explore_threads (one per thread): counts the tiles it is given and hands them on,
+// compressed into a batch for the writer (TileWork::flush's payload), or to a TileWriter
+// of its own (uncompressed files).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/kernels.hpp"
+#include "io/partial_file.hpp"
+#include "job/grid.hpp"
+#include "job/job.hpp"
+#include "run/schedule.hpp"
+
+namespace superball {
+
+class ExploreWork : public TileWork {
+public:
+    // The points of this worker's tiles by outcome code (outcome_count entries), then the
+    // points the kernel counted (fewer than the tiles' with refinement), then the points of
+    // its tiles.
+    virtual std::vector<std::uint64_t> tallies() const = 0;
+};
+
+// `writer`: where uncompressed tiles go (nullptr for a compressed file). Every argument must
+// outlive the work.
+std::unique_ptr<ExploreWork> make_explore_work(const Job& job, const Grid& grid, const Tiling& tiling,
+                                               const PartialLayout& layout, TileWriter* writer, CountKernel kernel);
+
+// Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
+double peak_rss_mib();
+
+}  // namespace superball

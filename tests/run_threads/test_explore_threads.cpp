@@ -1,0 +1,194 @@
+// run_explore_threads (run/explore_threads.hpp), in one process without MPI: the result
+// equals the kernel point by point at any thread count, compressed or not; a stopped run
+// keeps its partial file and resumes to the same result; outputs are refused as by
+// run_explore; the provenance says threads.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/count.hpp"
+#include "core/kernels.hpp"
+#include "io/layout.hpp"
+#include "io/result_reader.hpp"
+#include "job/grid.hpp"
+#include "job/job.hpp"
+#include "job/provenance.hpp"
+#include "run/explore_threads.hpp"
+
+namespace superball {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+public:
+    TempDir()
+    {
+        std::string templ = (fs::temp_directory_path() / "superball-threads-XXXXXX").string();
+        if (!mkdtemp(templ.data())) throw std::runtime_error("mkdtemp failed");
+        path_ = templ;
+    }
+    ~TempDir()
+    {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    fs::path operator/(const std::string& name) const { return path_ / name; }
+
+private:
+    fs::path path_;
+};
+
+Job job_of(const std::string& run)
+{
+    return parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 61 }\nU = -1.0\n"
+                     "W = { min = -3.0, max = 3.0, n = 47 }\n[run]\nmax_bounces = 1000\n" + run + "\n",
+                     "test job");
+}
+
+struct Data {
+    std::vector<std::uint32_t> counts;
+    std::vector<std::uint8_t> outcomes;
+};
+
+Data direct(const Job& job)
+{
+    const Grid grid(job);
+    const Box all{Extent(grid.shape().size(), 0), grid.shape()};
+    Starts starts;
+    grid.starts(all, starts);
+    Data d{std::vector<std::uint32_t>(starts.size()), std::vector<std::uint8_t>(starts.size())};
+    count_each(starts.view(), ModelMatrices::of(job.model), job.max_bounces, d.counts, d.outcomes);
+    return d;
+}
+
+Data read_result(const fs::path& path)
+{
+    const ResultReader reader(path);
+    EXPECT_EQ(reader.info().kind, FileKind::result);
+    const Box all{Extent(reader.info().shape.size(), 0), reader.info().shape};
+    Data d{std::vector<std::uint32_t>(all.points()), std::vector<std::uint8_t>(all.points())};
+    EXPECT_EQ(reader.read(all, d.counts, d.outcomes), 0u);
+    return d;
+}
+
+class Tally final : public RunObserver {
+public:
+    void started(const RunStart& s) override { start = s; }
+    void tiles_done(std::uint64_t t, std::uint64_t p) override
+    {
+        tiles += t;
+        points += p;
+    }
+    RunStart start;
+    std::uint64_t tiles = 0, points = 0;
+};
+
+const StopRequested never = [] { return false; };
+
+ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrite = false)
+{
+    ExploreSettings s;
+    s.output = out;
+    s.resume = resume;
+    s.overwrite = overwrite;
+    s.command = "test run";
+    return s;
+}
+
+TEST(RunExploreThreads, EqualsTheKernelPointByPointAtAnyThreadCount)
+{
+    const TempDir dir;
+    for (const char* run : {"tile_points = 64", "tile_points = 64\ncompression = 0\nalignment = 4096"}) {
+        const Job job = job_of(run);
+        const Data want = direct(job);
+        for (const unsigned threads : {1u, 2u, 5u}) {
+            SCOPED_TRACE(testing::Message() << run << ", " << threads << " threads");
+            const fs::path out = dir / ("r" + std::to_string(threads) + std::to_string(job.compression) + ".h5");
+            Tally tally;
+            const RunSummary r = run_explore_threads(job, settings(out), threads, tally, never);
+            EXPECT_TRUE(r.complete);
+            EXPECT_EQ(r.points_this_run, job.points());
+            EXPECT_EQ(tally.tiles, tally.start.tiles);
+            EXPECT_EQ(tally.points, job.points());
+            std::uint64_t histogram = 0;
+            for (const std::uint64_t n : r.outcomes) histogram += n;
+            EXPECT_EQ(histogram, job.points());
+            const Data got = read_result(out);
+            EXPECT_EQ(got.counts, want.counts);
+            EXPECT_EQ(got.outcomes, want.outcomes);
+            EXPECT_FALSE(fs::exists(layout::partial_path(out)));
+            EXPECT_TRUE(fs::exists(dir / ("r" + std::to_string(threads) + std::to_string(job.compression) + ".xmf")));
+            const ResultInfo info = ResultReader(out).info();
+            EXPECT_EQ(info.mpi_ranks, 1);
+            EXPECT_EQ(info.threads, threads);
+            EXPECT_EQ(info.history.rfind(info.date_created + " test run [", 0), 0u) << info.history;
+            EXPECT_NE(info.history.find(std::to_string(threads) + " thread"), std::string::npos) << info.history;
+        }
+    }
+}
+
+TEST(RunExploreThreads, StoppedRunResumesToTheSameResult)
+{
+    const TempDir dir;
+    const Job job = job_of("tile_points = 16\ncheckpoint_seconds = 0.01");
+    const fs::path out = dir / "stopped.h5";
+    // The calling thread asks after each of its tiles: stop after 20 of them.
+    std::atomic<int> polls{0};
+    const StopRequested stop = [&] { return ++polls > 20; };
+    Tally first;
+    const RunSummary r = run_explore_threads(job, settings(out), 2, first, stop);
+    EXPECT_TRUE(r.interrupted);
+    EXPECT_FALSE(fs::exists(out));
+    {
+        const ResultReader partial(layout::partial_path(out));
+        EXPECT_GT(partial.info().tiles_done, 0u);
+        EXPECT_LT(partial.info().tiles_done, partial.info().tiles);
+        EXPECT_TRUE(partial.damaged_tiles().empty());
+    }
+    // Refused without resume; resumed, only the tiles left are counted.
+    Tally refused;
+    EXPECT_THROW(run_explore_threads(job, settings(out), 2, refused, never), InputError);
+    Tally second;
+    const RunSummary resumed = run_explore_threads(job, settings(out, true), 3, second, never);
+    EXPECT_TRUE(resumed.complete);
+    EXPECT_EQ(second.start.tiles_done + second.tiles, second.start.tiles);
+    EXPECT_LT(resumed.points_this_run, job.points());
+    const Data got = read_result(out);
+    const Data want = direct(job);
+    EXPECT_EQ(got.counts, want.counts);
+    EXPECT_EQ(got.outcomes, want.outcomes);
+    const ResultInfo info = ResultReader(out).info();
+    EXPECT_NE(info.history.find('\n'), std::string::npos) << info.history;  // a line per run
+    Tally nothing;
+    EXPECT_TRUE(run_explore_threads(job, settings(out, true), 2, nothing, never).nothing_to_do);
+}
+
+TEST(RunExploreThreads, RefusesOutputsAsTheCommandLineDoes)
+{
+    const TempDir dir;
+    const Job job = job_of("tile_points = 256");
+    const fs::path out = dir / "r.h5";
+    Tally t;
+    run_explore_threads(job, settings(out), 2, t, never);
+    EXPECT_THROW(run_explore_threads(job, settings(out), 2, t, never), InputError);  // exists
+    EXPECT_TRUE(run_explore_threads(job, settings(out, false, true), 2, t, never).complete);  // --overwrite
+    const fs::path text = dir / "thesis.tex";
+    { std::ofstream(text) << "\\documentclass{article}\n"; }
+    try {
+        run_explore_threads(job, settings(text, false, true), 2, t, never);
+        ADD_FAILURE() << "a file not superball's was replaced";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("not a superball file"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace superball
