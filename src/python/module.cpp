@@ -9,7 +9,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -50,15 +52,23 @@ public:
     CoordinateArray(std::string name, const py::array& a) : name_(std::move(name)), array_(a)
     {
         const py::dtype t = a.dtype();
-        if (t.kind() != 'f' || (t.itemsize() != 8 && t.itemsize() != 4)) {
-            throw py::type_error(name_ + ": a float64 or float32 array is expected here");
+        // Native byte order only: the package swaps any other (a '>f8' array read as it is
+        // gave wrong counts without a word).
+        // (NumPy's descriptor may spell the native order '<' as well as '=': h5py's arrays do.)
+        const char native = std::endian::native == std::endian::little ? '<' : '>';
+        const bool native_order = t.byteorder() == '=' || t.byteorder() == native;
+        if (t.kind() != 'f' || (t.itemsize() != 8 && t.itemsize() != 4) || !native_order) {
+            throw py::type_error(name_ + ": a float64 or float32 array in native byte order is expected here");
         }
         f32_ = t.itemsize() == 4;
         data_ = static_cast<const char*>(a.data());
+        // The kernel reads a contiguous float64 array in place, as doubles: only when they are
+        // aligned (a view into a byte buffer may not be; gather() copies those).
+        aligned_ = reinterpret_cast<std::uintptr_t>(a.data()) % alignof(double) == 0;
         shape_.assign(a.shape(), a.shape() + a.ndim());
         strides_.assign(a.strides(), a.strides() + a.ndim());
         py::ssize_t expected = static_cast<py::ssize_t>(t.itemsize());
-        contiguous_ = !f32_;
+        contiguous_ = !f32_ && aligned_;
         for (std::size_t k = shape_.size(); k-- > 0;) {
             if (shape_[k] != 1 && strides_[k] != expected) contiguous_ = false;
             expected *= shape_[k];
@@ -68,7 +78,7 @@ public:
     const std::vector<py::ssize_t>& shape() const { return shape_; }
 
     // The values themselves when they lie as float64 one after the other (no copy needed).
-    const double* contiguous() const { return contiguous_ ? reinterpret_cast<const double*>(data_) : nullptr; }
+    const double* contiguous() const { return contiguous_ ? static_cast<const double*>(array_.data()) : nullptr; }
 
     // Values [first, first + n) as doubles into out.
     void read(std::size_t first, std::size_t n, double* out) const
@@ -149,6 +159,7 @@ private:
     const char* data_ = nullptr;
     std::vector<py::ssize_t> shape_, strides_;
     bool f32_ = false;
+    bool aligned_ = false;
     bool contiguous_ = false;
 };
 

@@ -192,6 +192,14 @@ def test_layouts_and_dtypes_give_the_same_counts(superball):
     ref = superball.count(*(a.astype(np.float64) for a in f32), **MODEL)
     np.testing.assert_array_equal(got.wall_bounces, ref.wall_bounces)
     np.testing.assert_array_equal(got.outcome, ref.outcome)
+    # The other byte order is swapped, not misread; unaligned float64 (a view into a byte
+    # buffer) is read right.
+    got = superball.count(xi.astype(">f8"), U.astype(">f4").astype(">f8"), W.astype(">f8"), **MODEL)
+    np.testing.assert_array_equal(got.wall_bounces, superball.count(xi, U.astype(np.float32), W, **MODEL).wall_bounces)
+    raw = np.zeros(xi.size * 8 + 1, np.uint8)[1:].view(np.float64).reshape(xi.shape)
+    raw[...] = xi
+    assert not raw.flags.aligned
+    np.testing.assert_array_equal(superball.count(raw, U, W, **MODEL).wall_bounces, want.wall_bounces)
     # Integers are converted; lists work; a grid by broadcasting.
     assert superball.count([1, 2], -1, 0, **MODEL).outcome.tolist() == [2, 2]  # xi >= 1: missed
     line = np.linspace(0.01, 0.99, 30)

@@ -145,7 +145,9 @@ def _coordinate(name, value):
     except Exception as error:  # ragged nested lists, objects NumPy cannot hold
         raise TypeError(f"{name} must be real numbers (a number or an array), not {type(value).__name__}: {error}")
     if a.dtype.kind == "f" and a.dtype.itemsize in (4, 8):
-        return a
+        # Another byte order (">f8" on this little-endian machine: data from a file, say) is
+        # swapped here; read as it is it gave wrong counts without a word.
+        return a if a.dtype.isnative else a.astype(a.dtype.newbyteorder("="))
     if a.dtype.kind in "fiub":  # float16, integers, booleans: converted (a copy)
         return a.astype(np.float64)
     raise TypeError(f"{name} must be real numbers (a number or an array), not an array of {a.dtype}")
