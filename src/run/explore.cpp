@@ -220,6 +220,31 @@ Decision decide(const ExploreSettings& s, const fs::path& out, const Job& job)
 
 }  // namespace
 
+StartedPartial start_partial(const fs::path& partial, PlanMode mode, const Job& job, const Grid& grid, int ranks,
+                             const Provenance& provenance)
+{
+    StartedPartial p;
+    try {
+        if (mode == PlanMode::fresh) {
+            const Tiling tiling = default_tiling(job, ranks);
+            p.tile_shape = tiling.tile_shape();
+            p.layout = create_partial(partial, job, grid, tiling, provenance);
+            p.journal.done.assign(tiling.tiles(), 0);
+            p.journal.checksums.assign(tiling.tiles(), 0);
+        } else {
+            const ResultReader reader(partial);
+            p.tile_shape = reader.info().tile_shape;
+            p.layout = partial_layout(partial, Tiling(grid.shape(), p.tile_shape));
+            p.journal = {reader.tiles_done(), reader.tile_checksums(), reader.tile_stored()};
+            p.earlier_seconds = reader.info().wall_seconds;
+        }
+    } catch (const std::exception& e) {
+        throw RunError(fmt::format("{} {} failed ({}){}", mode == PlanMode::fresh ? "creating" : "reading", partial.string(),
+                                   e.what(), free_space_note(partial)));
+    }
+    return p;
+}
+
 double peak_rss_mib()
 {
     rusage u{};
@@ -438,37 +463,22 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
 
     // The partial file and its journal: made by rank 0 (a new run) or read (a resume).
     const Grid grid(job);
-    Extent tile_shape;
-    PartialLayout layout;
-    TileJournal journal;
-    double earlier_seconds = 0;  // of the runs before a resume
+    StartedPartial started_partial;
     std::int64_t failed = 0;
     std::string failure;
     if (comm.is_root()) {
         try {
-            if (plan.mode == PlanMode::fresh) {
-                const Tiling tiling = default_tiling(job, comm.size());
-                tile_shape = tiling.tile_shape();
-                layout = create_partial(partial, job, grid, tiling, provenance);
-                journal.done.assign(tiling.tiles(), 0);
-                journal.checksums.assign(tiling.tiles(), 0);
-            } else {
-                const ResultReader reader(partial);
-                tile_shape = reader.info().tile_shape;
-                layout = partial_layout(partial, Tiling(grid.shape(), tile_shape));
-                journal = {reader.tiles_done(), reader.tile_checksums(), reader.tile_stored()};
-                earlier_seconds = reader.info().wall_seconds;
-            }
-        } catch (const std::exception& e) {
+            started_partial = start_partial(partial, plan.mode, job, grid, comm.size(), provenance);
+        } catch (const RunError& e) {
             failed = 1;
-            failure = fmt::format("{} {} failed ({}){}", plan.mode == PlanMode::fresh ? "creating" : "reading",
-                                  partial.string(), e.what(), free_space_note(partial));
+            failure = e.what();
         }
     }
     if (comm.broadcast(failed) != 0) {
         comm.broadcast(failure);
         throw RunError(failure);
     }
+    auto& [tile_shape, layout, journal, earlier_seconds] = started_partial;
     comm.broadcast(tile_shape);
     broadcast(comm, layout);
     const Tiling tiling(grid.shape(), tile_shape);

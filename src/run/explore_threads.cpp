@@ -107,28 +107,8 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     // The partial file and its journal, as run_explore makes or reads them; the tiling of a
     // new file is the one `mpirun -n THREADS` would choose.
     const Grid grid(job);
-    Extent tile_shape;
-    PartialLayout layout;
-    TileJournal journal;
-    double earlier_seconds = 0;
-    try {
-        if (plan.mode == PlanMode::fresh) {
-            const Tiling tiling = default_tiling(job, static_cast<int>(threads));
-            tile_shape = tiling.tile_shape();
-            layout = create_partial(partial, job, grid, tiling, provenance);
-            journal.done.assign(tiling.tiles(), 0);
-            journal.checksums.assign(tiling.tiles(), 0);
-        } else {
-            const ResultReader reader(partial);
-            tile_shape = reader.info().tile_shape;
-            layout = partial_layout(partial, Tiling(grid.shape(), tile_shape));
-            journal = {reader.tiles_done(), reader.tile_checksums(), reader.tile_stored()};
-            earlier_seconds = reader.info().wall_seconds;
-        }
-    } catch (const std::exception& e) {
-        throw RunError(fmt::format("{} {} failed ({}){}", plan.mode == PlanMode::fresh ? "creating" : "reading",
-                                   partial.string(), e.what(), free_space_note(partial)));
-    }
+    auto [tile_shape, layout, journal, earlier_seconds] =
+        start_partial(partial, plan.mode, job, grid, static_cast<int>(threads), provenance);
     const Tiling tiling(grid.shape(), tile_shape);
     PartialFile file(partial, tiling, layout);
     std::vector<std::uint64_t> done_tiles, sums, pending;

@@ -5,13 +5,17 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <vector>
 
 #include "core/kernels.hpp"
 #include "io/partial_file.hpp"
+#include "io/stored_tiles.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
+#include "job/provenance.hpp"
+#include "run/explore.hpp"
 #include "run/schedule.hpp"
 
 namespace superball {
@@ -28,6 +32,18 @@ public:
 // outlive the work.
 std::unique_ptr<ExploreWork> make_explore_work(const Job& job, const Grid& grid, const Tiling& tiling,
                                                const PartialLayout& layout, TileWriter* writer, CountKernel kernel);
+
+// The partial file as a run starts on it: made anew (`fresh`: the tiling `ranks` ranks
+// choose) or read for a resume. Throws RunError naming the file (and its file system's free
+// space, when short). Called by one process only: rank 0, or run_explore_threads.
+struct StartedPartial {
+    Extent tile_shape;
+    PartialLayout layout;
+    TileJournal journal;
+    double earlier_seconds = 0;  // of the runs before a resume
+};
+StartedPartial start_partial(const std::filesystem::path& partial, PlanMode mode, const Job& job, const Grid& grid, int ranks,
+                             const Provenance& provenance);
 
 // Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
 double peak_rss_mib();

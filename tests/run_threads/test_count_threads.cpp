@@ -120,6 +120,9 @@ TEST(CountOnThreads, AFailingLoadStopsTheRunAndIsRethrown)
     std::atomic<int> calls{0};
     const LoadStarts load = [&](std::size_t first, std::size_t count, Starts&) -> StartsView {
         if (++calls == 3) throw std::runtime_error("cannot read block");
+        // A load takes a moment, as reading does: on a busy machine the other threads would
+        // otherwise take every block before the failing one has stopped them.
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
         return s.view().subview(first, count);
     };
     EXPECT_THROW(threaded(load, n, 1000, 3), std::runtime_error);
