@@ -16,30 +16,14 @@
 #include "io/hdf5.hpp"
 #include "io/placed_chunks.hpp"
 #include "job/tiles.hpp"
+#include "../temp_dir.hpp"
 
 namespace superball {
 namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
-public:
-    TempDir()
-    {
-        std::string t = (fs::temp_directory_path() / "superball-placed-XXXXXX").string();
-        if (!mkdtemp(t.data())) throw std::runtime_error("mkdtemp");
-        path_ = t;
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-
-private:
-    fs::path path_;
-};
+using test_support::TempDir;
 
 std::string bytes_of(const fs::path& p)
 {
@@ -103,7 +87,7 @@ struct Fixture {
 // A fixture file with its chunks appended, not yet indexed.
 class PlacedChunksTest : public ::testing::Test {
 protected:
-    const TempDir dir;
+    const TempDir dir{"superball-placed"};
     const fs::path path = dir / "f.h5";
     const Fixture fixture{path};
     const std::vector<Fixture::Placed> placed = fixture.append_chunks(path);

@@ -19,32 +19,14 @@
 #include "job/job.hpp"
 #include "job/provenance.hpp"
 #include "run/explore_threads.hpp"
+#include "../temp_dir.hpp"
 
 namespace superball {
 namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
-public:
-    TempDir()
-    {
-        std::string templ = (fs::temp_directory_path() / "superball-threads-XXXXXX").string();
-        if (!mkdtemp(templ.data())) throw std::runtime_error("mkdtemp failed");
-        path_ = templ;
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-
-private:
-    fs::path path_;
-};
+using test_support::TempDir;
 
 Job job_of(const std::string& run)
 {
@@ -105,7 +87,7 @@ ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrit
 
 TEST(RunExploreThreads, EqualsTheKernelPointByPointAtAnyThreadCount)
 {
-    const TempDir dir;
+    const TempDir dir{"superball-threads"};
     for (const char* run : {"tile_points = 64", "tile_points = 64\ncompression = 0\nalignment = 4096"}) {
         const Job job = job_of(run);
         const Data want = direct(job);
@@ -137,7 +119,7 @@ TEST(RunExploreThreads, EqualsTheKernelPointByPointAtAnyThreadCount)
 
 TEST(RunExploreThreads, StoppedRunResumesToTheSameResult)
 {
-    const TempDir dir;
+    const TempDir dir{"superball-threads"};
     const Job job = job_of("tile_points = 16\ncheckpoint_seconds = 0.01");
     const fs::path out = dir / "stopped.h5";
     // The calling thread asks after each of its tiles: stop after 20 of them.
@@ -173,7 +155,7 @@ TEST(RunExploreThreads, StoppedRunResumesToTheSameResult)
 
 TEST(RunExploreThreads, RefusesOutputsAsTheCommandLineDoes)
 {
-    const TempDir dir;
+    const TempDir dir{"superball-threads"};
     const Job job = job_of("tile_points = 256");
     const fs::path out = dir / "r.h5";
     Tally t;
