@@ -7,7 +7,7 @@
 # Environment: SUPERBALL_RANKS (default: number of cores), SUPERBALL_BUILD (build
 # directory, default build/native: optimised for this host's instruction set). On one
 # node superball asks Open MPI for its shared-memory layer (ob1) itself, unless
-# OMPI_MCA_pml is set (README: Start-up on one node).
+# OMPI_MCA_pml is set (docs/running.md: Start-up on one node).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(dirname "$here")

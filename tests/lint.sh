@@ -5,7 +5,7 @@
 # SUPERBALL_BUILD_DIR picks another build). Exits non-zero on any finding.
 #
 #   tests/lint.sh            cppcheck (seconds) and clang-tidy (about 4 minutes on 2 cores)
-#   tests/lint.sh --quick    cppcheck only (what tests/run runs)
+#   tests/lint.sh --quick    cppcheck only (what tests/all runs)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"

@@ -7,6 +7,23 @@ import unittest
 SOURCE = os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
+SKIP_RETURN_CODE = 77  # ctest's SKIP_RETURN_CODE for these files (tests/CMakeLists.txt)
+
+
+def main():
+    """unittest.main() with an exit status ctest can read: 1 on a failure, 77 (reported as
+    skipped, not passed) when every test of the file skipped; 0 otherwise, after a line
+    naming any tests that skipped."""
+    import sys
+    result = unittest.main(exit=False).result
+    if not result.wasSuccessful():
+        sys.exit(1)
+    reasons = sorted({reason for _, reason in result.skipped})
+    if result.skipped:
+        print(f"skipped {len(result.skipped)} of {result.testsRun} tests: {'; '.join(reasons)}", file=sys.stderr)
+    sys.exit(SKIP_RETURN_CODE if result.testsRun > 0 and len(result.skipped) == result.testsRun else 0)
+
+
 def superball_binary():
     """The binary under test: $SUPERBALL (set by ctest), else a build of this repository."""
     path = os.environ.get("SUPERBALL")

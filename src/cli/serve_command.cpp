@@ -22,7 +22,7 @@ Runner add_serve_command(CLI::App& app)
     sub->footer(
         "Serves a page with a deep-zoom map of wall-bounce counts (or outcomes) over two canonical axes, computed\n"
         "on demand at the zoom's resolution, the trajectory of a clicked launch, and \"export this view\" as a\n"
-        "job file; and the JSON API behind it (/api/count, /api/region, /api/trajectory, /api/job; README).\n"
+        "job file; and the JSON API behind it (/api/count, /api/region, /api/trajectory, /api/job; docs/commands.md).\n"
         "Result files given as arguments open as layers. Binds to 127.0.0.1 (this machine only) unless --host\n"
         "says otherwise; prints the URL and serves until Ctrl-C or SIGTERM.");
     auto opt = std::make_shared<ServeOptions>();

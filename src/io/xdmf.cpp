@@ -109,7 +109,7 @@ std::filesystem::path write_xdmf(const std::filesystem::path& result, const Resu
     // take the type of an array before reading it. The legacy reader reads the whole
     // dataset by its number of points; reading pieces of a 2-D result (ParaView in
     // parallel, the reader's Stride) it selects a hyperslab of the mesh's rank in the
-    // file's and fails, saying so (README: ParaView).
+    // file's and fails, saying so (docs/format.md: ParaView).
     const std::string count_type = info.max_bounces > std::numeric_limits<std::int32_t>::max() ? "8" : "4";
     for (const auto& [name, precision] : {std::pair{"wall_bounces", count_type}, std::pair{"outcome", std::string("4")}}) {
         f.print("   <Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"Node\">\n", name);

@@ -29,7 +29,9 @@ constexpr std::uint64_t final_message = 2;  // the sender is done: no message fo
 constexpr std::uint64_t stopping = 4;       // the sender saw a stop: stop everyone
 constexpr std::uint64_t gift = 8;           // answers give_back (with no range: none to give)
 // Down message: {kind, first, count, tiles the sender has left to hand out}.
-enum class Down : std::uint64_t { assign = 1, end = 2, stop = 3, bye = 4, give_back = 5 };
+// give_back: every unstarted tile but the next; give_one: the next too, from a rank in the
+// middle of a tile (the end of a run, see Scheduler::rebalance).
+enum class Down : std::uint64_t { assign = 1, end = 2, stop = 3, bye = 4, give_back = 5, give_one = 6 };
 constexpr int down_words = 4;
 
 struct Range {
@@ -109,7 +111,8 @@ double now() { return MPI_Wtime(); }
 // but one, not half: a rank whose block turned out costly held it whole until asked, and
 // halving it took one round trip per halving while others waited (at 4096 simulated
 // ranks, the ranks that kept their first block computed 76 s against a mean of 67, and
-// the others waited 7 s each on average).
+// the others waited 7 s each on average). Once nobody holds two, a rank in the middle of a
+// tile is asked for its next one too (Down::give_one), one tile per rank out of work.
 class Scheduler {
 public:
     Scheduler(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work, const TilesDone& done,
@@ -166,7 +169,9 @@ public:
                 // which may be given back while this one is computed.
                 const std::uint64_t i = current_.first++;
                 --current_.count;
+                computing_ = true;
                 work_.compute(pending_[i], serve_);
+                computing_ = false;
                 ++stats.tiles;
                 ++unflushed_;
                 if (work_.should_flush()) report_own();
@@ -196,6 +201,7 @@ private:
         bool stop_sent = false;
         bool waiting = false;         // asked for a block this server does not have yet
         bool asked_back = false;      // was asked to give tiles back, no answer yet
+        bool asked_one = false;       // ... for one tile (Down::give_one)
         bool for_server = false;      // ... for this rank's server, which waits for the answer
     };
 
@@ -487,8 +493,12 @@ private:
             c.asked_back = false;
             // Nothing to give, whatever it said before (it started those tiles since, or
             // they were on their way): not asked again before its next message says so,
-            // or rank 0 and a leader would trade requests and empty answers.
-            if (std::all_of(given.begin(), given.end(), [](const Range& r) { return r.count == 0; })) c.unstarted = 0;
+            // or rank 0 and a leader would trade requests and empty answers. Asked for all
+            // but one, it may still hold that one (for Down::give_one at the end).
+            if (std::all_of(given.begin(), given.end(), [](const Range& r) { return r.count == 0; })) {
+                c.unstarted = c.asked_one ? 0 : std::min<std::uint64_t>(c.unstarted, 1);
+            }
+            c.asked_one = false;
             received_back(c, given);
         }
         if (flags & want_block) {
@@ -561,6 +571,9 @@ private:
         case Down::give_back:
             give_back();
             break;
+        case Down::give_one:
+            give_one();
+            break;
         case Down::bye:
             throw std::logic_error("schedule: goodbye from the server before this rank's final message");
         }
@@ -593,6 +606,41 @@ private:
         maybe_request();  // the queued block may have gone back
     }
 
+    // The server wants one tile for a rank out of work, at the end of the run: this rank's
+    // next one if it is in the middle of a tile (between tiles it is about to start it), or
+    // one from a rank it serves.
+    void give_one()
+    {
+        if (stopped_) {
+            send_up(gift);
+            return;
+        }
+        if (computing_ && current_.count + pool_tiles_ > 0) {
+            ++stats.given_back;
+            gathered_ = take_back(1);
+            pass_gathered_up();
+            maybe_request();
+            return;
+        }
+        if (Child* c = child_holding_one()) {
+            ask(*c, Down::give_one);
+            c->for_server = true;
+            owed_answers_ = 1;
+            owe_back_ = true;
+            return;
+        }
+        send_up(gift);
+    }
+
+    // A rank served here that holds, as last heard, an unstarted tile and was not asked for it.
+    Child* child_holding_one()
+    {
+        for (Child& c : children_) {
+            if (c.active && !c.asked_back && c.unstarted + c.in_flight >= 1) return &c;
+        }
+        return nullptr;
+    }
+
     const Child* fullest_child() const
     {
         const Child* best = nullptr;
@@ -612,11 +660,12 @@ private:
         return true;
     }
 
-    void ask(Child& c)
+    void ask(Child& c, Down kind = Down::give_back)
     {
         c.asked_back = true;
+        c.asked_one = kind == Down::give_one;
         ++stats.asked_back;
-        send_down(c, Down::give_back);
+        send_down(c, kind);
     }
 
     // This rank first if it has nothing to compute either, then the ranks out of work, then
@@ -669,6 +718,25 @@ private:
             return;
         }
         while (asked < waiting && ask_back()) ++asked;
+        // Once no block will come from above and nobody holds two, a rank in the middle of a
+        // tile gives up the next one it keeps: else the last tiles of the run may be a
+        // rank's current tile and then its next, both among the costliest (at 4096
+        // simulated ranks, sweep_e_alpha's last tile ended 11 s after the first rank ran
+        // out of work, two tiles of 5.75 s; tests/scale). This rank's own first: no message.
+        if ((last_word || parent_remaining_ == 0) && asked == 0 && fullest_child() == nullptr) {
+            if (computing_ && current_.count == 1 && waiting > 0) {
+                ++stats.given_back;
+                for (const Range& r : take_back(1)) add_to_pool(r);
+                serve_waiting();
+                return;
+            }
+            while (asked < waiting) {
+                Child* c = child_holding_one();
+                if (!c) break;
+                ask(*c, Down::give_one);
+                ++asked;
+            }
+        }
         // Someone can still give tiles back, or blocks can come from above: the waiting
         // ranks wait for them.
         if (!last_word || asked > 0 || splittable_below() || current_.count >= 2) return;
@@ -769,6 +837,7 @@ private:
     bool root_ = false;
     bool leader_ = false;
     bool computes_ = true;
+    bool computing_ = false;  // in the middle of a tile (messages are handled from within it)
     std::uint64_t computing_ranks_ = 1;       // ranks computing tiles, in all
     std::uint64_t node_computing_ranks_ = 1;  // of which on this node
     Serve serve_;

@@ -17,7 +17,7 @@
 // - across nodes (more than one node, found with MPI_Comm_split_type), rank 0 hands big
 //   blocks to one leader per node, which sub-divides them among its node's ranks and
 //   forwards their reports, so no process serves more than its node's requests plus one
-//   message per leader (see README, "Running on a cluster");
+//   message per leader (see docs/running.md, "Running on a cluster");
 // - at the end, ranks holding unstarted tiles give them back for the ranks out of work:
 //   within a node through its leader, across nodes through rank 0.
 // The order of `pending` is the caller's (job/tiles.hpp, handout_order: interleaved from

@@ -1,7 +1,7 @@
 // superball serve: an HTTP server for exploring the regions in a browser. It serves the
 // page (web/, built into the binary, and Debian's Leaflet), map tiles computed on demand
-// at the zoom's resolution, and the JSON API the page uses (README: The explorer and its
-// API): /api/count, /api/region, /api/trajectory, /api/job, /api/legend, /api/info.
+// at the zoom's resolution, and the JSON API the page uses (docs/commands.md: Exploring
+// in a browser, The API): /api/count, /api/region, /api/trajectory, /api/job, /api/legend, /api/info.
 #pragma once
 
 #include <filesystem>

@@ -29,6 +29,7 @@ import region_map  # noqa: E402
 import superball_results  # noqa: E402
 import trajectory_plot  # noqa: E402
 from fixtures import CAPPED, INVALID, LEFT, MISSED, banded_data, make_result  # noqa: E402
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import tile_boxes  # noqa: E402
 
 SCRIPTS = ("region_map.py", "trajectory_plot.py", "summary.py", "bifurcation_plot.py")
@@ -679,4 +680,4 @@ class BifurcationPlotTest(ScriptTestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

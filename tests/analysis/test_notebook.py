@@ -21,6 +21,7 @@ from PIL import Image
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import SOURCE, mpi_env, superball_binary  # noqa: E402
 
 NOTEBOOK = os.path.join(SOURCE, "analysis", "region_trajectory.ipynb")
@@ -128,4 +129,4 @@ class NotebookTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Size and h5py read times of results at each compression level (README: Result file).
+"""Size and h5py read times of results at each compression level (docs/format.md: Size and read times).
 
 Runs `superball explore` under mpirun on the quickstart region (xi in (0, 1), U = -1,
 W in [-3, 3], e = alpha = 0.9, max_bounces 1000; a volume adds U in [-3, 0]) with

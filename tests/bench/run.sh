@@ -12,7 +12,7 @@
 #
 #   tests/bench/run.sh [--quick] [--repetitions N] [--skip-16384] [--baseline SUPERBALL]
 #
-# Works on whatever build trees are there: build/release (portable, as tests/run leaves
+# Works on whatever build trees are there: build/release (portable, as tests/all leaves
 # it) and build/native (-march=native, as jobs/local.sh leaves it) are configured with
 # their presets when missing, SUPERBALL_BENCHMARKS is turned on where it is off, and only
 # the superball and bench_kernel targets are built, one tree after the other.

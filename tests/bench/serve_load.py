@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Timings of `superball serve` for the README: map tiles of the quickstart view and a
+"""Timings of `superball serve` for docs/commands.md: map tiles of the quickstart view and a
 concurrent load of region requests.
 
   /usr/bin/python3 tests/bench/serve_load.py [--superball BINARY] [--repeat 3] [--threads 2]

@@ -2,7 +2,7 @@
 # Installs the browser test's driver, puppeteer-core at the version pinned in package.json
 # and package-lock.json, into tests/browser/node_modules (npm ci: exactly the lock file);
 # nothing when that version is there. puppeteer-core downloads no browser: the test drives
-# Debian's chromium (.ci/install-deps --browser). Called by tests/run.
+# Debian's chromium (.ci/install-deps --browser). Called by tests/all.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 command -v node >/dev/null && command -v npm >/dev/null ||

@@ -7,7 +7,7 @@ the count `superball count` gives, and the ball moves), exports the view (a job 
 explore --dry-run` accepts) and saves a screenshot: $SUPERBALL_SCREENSHOT, else
 explorer.png in the working directory.
 
-Needs node and tests/browser/install.sh (tests/run calls it). Label browser.
+Needs node and tests/browser/install.sh (tests/all calls it). Label browser.
 """
 
 import json
@@ -21,6 +21,7 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import Server, superball_binary  # noqa: E402
 
 BINARY = superball_binary()
@@ -100,4 +101,4 @@ class BrowserTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

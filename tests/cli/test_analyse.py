@@ -26,6 +26,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import interrupted_run  # noqa: E402
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
@@ -279,4 +280,4 @@ class OtherShapes(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

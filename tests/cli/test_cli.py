@@ -457,4 +457,8 @@ class BadInput(CliTestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    import sys
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    from superball_testing import main
+
+    main()

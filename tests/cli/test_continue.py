@@ -25,6 +25,7 @@ import unittest
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import mpi_env, superball_binary  # noqa: E402
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
@@ -422,4 +423,4 @@ class ContinueTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -235,4 +235,8 @@ class FixedPointsTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    import sys
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    from superball_testing import main
+
+    main()

@@ -5,7 +5,7 @@ variables, the data over the axes in order with their attributes, and no groups;
 `ncdump -v AXIS` prints the axis' samples. On results computed by the binary under test
 (the kinds of tests/clients/test_xarray.py).
 
-Needs Debian's netcdf-bin (.ci/install-deps --clients, which tests/run runs)."""
+Needs Debian's netcdf-bin (.ci/install-deps --clients, which tests/all runs)."""
 import os
 import re
 import shutil
@@ -18,6 +18,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import CLIENT_JOBS, client_results  # noqa: E402
 
 NCDUMP = shutil.which("ncdump")
@@ -88,4 +89,4 @@ class Ncdump(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

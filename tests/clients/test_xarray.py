@@ -7,7 +7,7 @@ commit, date_created, build). On results computed by the binary under test:
 a canonical slice, a volume, a physical slice and a slice swept over alpha.
 
 Needs Debian's python3-xarray, python3-h5netcdf and python3-netcdf4
-(.ci/install-deps --clients, which tests/run runs)."""
+(.ci/install-deps --clients, which tests/all runs)."""
 import os
 import shutil
 import sys
@@ -19,6 +19,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import CLIENT_JOBS, client_results  # noqa: E402
 
 try:
@@ -141,7 +142,7 @@ class Xarray(unittest.TestCase):
             self.assertEqual(set(ref["fixed"]), fixed, kind)
 
     def test_selection_by_value(self):
-        """The recipe of the README: a slice of the volume by value, as region_map.py draws it."""
+        """The recipe of docs/format.md (Reading results): a slice of the volume by value, as region_map.py draws it."""
         with self.open(self.results["volume"], None) as ds:
             near = ds["wall_bounces"].sel(U=-1.0, method="nearest")
             self.assertEqual(near.dims, ("xi", "W"))
@@ -152,4 +153,4 @@ class Xarray(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -15,6 +15,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import mpi_env, superball_binary  # noqa: E402
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
@@ -197,4 +198,4 @@ class SingleNodeStartUp(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

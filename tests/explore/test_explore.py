@@ -18,6 +18,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import descendants, killable_job, mpi_env, wall_impacts_per_second  # noqa: E402
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
@@ -488,4 +489,4 @@ class BadJobs(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -7,7 +7,7 @@ traceback or a hang); and `explore --resume` onto a damaged partial file is refu
 the file left byte for byte. Then the writer's side: `explore --overwrite` replaces
 superball's files only.
 
-Run by ctest under the release build and, in the asan stage of tests/run, with the
+Run by ctest under the release build and, in the asan stage of tests/all, with the
 binary built with AddressSanitizer (a report there exits 86, which no case expects).
 Environment: SUPERBALL (the binary), SUPERBALL_SOURCE_DIR (for analysis/)."""
 import json
@@ -24,6 +24,7 @@ import numpy as np
 import xxhash  # Debian's python3-xxhash
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import SOURCE, interrupted_run, mpi_env, stored_chunk, superball_binary  # noqa: E402
 
 ANALYSIS = os.path.join(SOURCE, "analysis")
@@ -645,4 +646,4 @@ class Overwrite(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -35,6 +35,7 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import (capped_job, descendants, killable_job, mpi_env, read_partial, superball_binary,  # noqa: E402
                                tile_boxes, wall_impacts_per_second)
 
@@ -137,7 +138,9 @@ class Signals(unittest.TestCase):
         """Until at least `fraction` of the tiles (and at least one) are recorded done."""
         deadline = time.time() + 300
         while time.time() < deadline:
-            self.assertIsNone(proc.poll(), "the run ended before it could be interrupted: make the grid larger")
+            if proc.poll() is not None:
+                with open(self.stderr_path) as f:
+                    self.fail(f"the run ended (status {proc.returncode}) before it could be interrupted:\n{f.read()}")
             try:
                 with h5py.File(output + ".partial", "r") as f:
                     done = f["progress/tile_done"][()]
@@ -258,4 +261,4 @@ class Signals(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

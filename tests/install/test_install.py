@@ -12,6 +12,7 @@ import tempfile
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import SOURCE, mpi_env  # noqa: E402
 
 BUILD = os.environ.get("SUPERBALL_BUILD_DIR", "")
@@ -129,4 +130,4 @@ class Installed(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -9,7 +9,7 @@ sidecar opened by absolute path from another working directory and as ./NAME.xmf
 its own, and the volume read in pieces by two pvbatch ranks.
 
 Needs Debian's paraview, python3-paraview, xvfb and xauth (.ci/install-deps --clients,
-which tests/run runs). About 15 s: each pvbatch start costs 2-3 s."""
+which tests/all runs). About 15 s: each pvbatch start costs 2-3 s."""
 import json
 import os
 import shutil
@@ -22,6 +22,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import client_results, mpi_env  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -162,7 +163,7 @@ class ParaView(unittest.TestCase):
     def test_relative_name_from_its_directory(self):
         """./NAME.xmf with every reader and OpenDataFile (which picks Xdmf3ReaderS); a bare
         NAME.xmf with the legacy reader (the Xdmf3 readers look for the data file in a
-        directory named NAME.xmf and abort pvpython: README)."""
+        directory named NAME.xmf and abort pvpython: docs/format.md)."""
         cases, labels = [], []
         for kind, path in self.results.items():
             name = os.path.basename(sidecar(path))
@@ -216,4 +217,4 @@ class ParaView(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -30,3 +30,12 @@ def superball():
     import superball as module
 
     return module
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Every test of the file skipped: exit 77, which ctest reports as skipped
+    (SKIP_RETURN_CODE in tests/CMakeLists.txt), not as passed."""
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if exitstatus == 0 and reporter is not None and session.testscollected > 0:
+        if len(reporter.stats.get("skipped", [])) == session.testscollected:
+            session.exitstatus = 77

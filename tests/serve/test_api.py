@@ -32,6 +32,7 @@ import numpy as np
 from PIL import Image
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import Server, interrupted_run, mpi_env, read_partial, superball_binary  # noqa: E402
 
 BINARY = superball_binary()
@@ -40,7 +41,7 @@ QUICKSTART = dict(x="xi", x_min=0, x_max=1, y="W", y_min=-3, y_max=3, U=-1, e=0.
 OUTCOME_RGB = np.array([(153, 153, 153), (31, 119, 180), (255, 127, 14), (0, 0, 0)], dtype=np.uint8)
 # A launch that bounces for ever without dissipation (superball_testing.capped_job).
 CAPPED = dict(x="xi", x_min=0.24, x_max=0.26, y="W", y_min=-1.27, y_max=-1.23, U=-0.5, e=1, alpha=1)
-# Under AddressSanitizer (tests/run's asan stage) counting is several times slower and
+# Under AddressSanitizer (tests/all's asan stage) counting is several times slower and
 # freed memory is held in quarantine: latencies are allowed this factor, memory not checked.
 SANITIZED = "ASAN_OPTIONS" in os.environ
 SLOWER = 10 if SANITIZED else 1
@@ -479,4 +480,4 @@ class LoadTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

@@ -27,7 +27,7 @@ Outcomes (codes as in result files, attribute flag_values / flag_meanings of /ou
     3 capped   max_bounces wall impacts and still bouncing
 
 Bad input raises ValueError (or TypeError for the wrong kind of object) naming the argument
-and its value. Counting runs with the GIL released. The repository's README (section Python)
+and its value. Counting runs with the GIL released. The repository's docs/python.md
 has examples; analysis/region_trajectory.ipynb draws a figure with it.
 """
 

@@ -1,7 +1,7 @@
 // The superball explorer: a Leaflet map of tiles computed by the server (/tile/Z/X/Y.png)
 // over a window of two canonical axes, the cursor's count (/api/count), the clicked
 // launch's trajectory (/api/trajectory) and the view as a job file (/api/job). The API is
-// documented in the README ("The explorer and its API").
+// documented in docs/commands.md ("Exploring in a browser: superball serve", The API).
 "use strict";
 
 (function () {

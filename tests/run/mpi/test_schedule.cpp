@@ -448,5 +448,47 @@ TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
                                    << r.stats.given_back;
 }
 
+// The last two tiles handed out are costly (0.3 s), the rest cost nothing: the rank that
+// gets the first of them has asked ahead and may hold the second too. Once the others are
+// out of work it gives that one up from the middle of its current tile (Down::give_one),
+// so no rank computes both. (Counted, not timed.)
+TEST_P(ScheduleTimed, TheLastCostlyTilesEndOnDifferentRanks)
+{
+    const int ranks = world.size();
+    const int computing = ranks - (GetParam().dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
+    if (computing < 2) GTEST_SKIP() << "one computing rank: nobody to give a tile to";
+    const std::uint64_t n = 20 * static_cast<std::uint64_t>(computing);
+    class LastTwoCostly final : public TileWork {
+    public:
+        explicit LastTwoCostly(std::uint64_t n) : n_(n) {}
+        void compute(std::uint64_t tile, const Serve& serve) override
+        {
+            const bool costly = tile + 2 >= n_;
+            for (int i = 0; costly && i < 60; ++i) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+                if (serve) serve();
+            }
+            if (costly) ++costly_tiles;
+            done_.push_back({tile, checksum_of(tile)});
+        }
+        Flushed flush() override { return {std::exchange(done_, {}), {}}; }
+        std::uint64_t costly_tiles = 0;
+
+    private:
+        std::uint64_t n_;
+        std::vector<TileReport> done_;
+    } work(n);
+    std::uint64_t reported = 0;
+    const TilesDone done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte>) { reported += tiles.size(); };
+    const ScheduleResult r = run_schedule(world, iota(n), work, done, [] { return false; }, settings_of(GetParam()));
+    EXPECT_FALSE(r.interrupted);
+    if (world.is_root()) {
+        EXPECT_EQ(reported, n);
+    }
+    std::uint64_t most = 0;
+    mpi::check(MPI_Allreduce(&work.costly_tiles, &most, 1, MPI_UINT64_T, MPI_MAX, world.get()), "MPI_Allreduce");
+    EXPECT_EQ(most, 1u) << "one rank computed both costly tiles, one after the other";
+}
+
 }  // namespace
 }  // namespace superball

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # A one-node Slurm cluster on this machine, for testing jobs/slurm/explore.sbatch.
 #
-#   tests/jobs/slurm_cluster.sh start     start it (or reuse one already working); last line of
+#   tests/launchers/slurm_cluster.sh start     start it (or reuse one already working); last line of
 #                                          output: SLURM_CONF=/path/to/slurm.conf (export it to use
 #                                          sbatch, squeue, scontrol with this cluster)
-#   tests/jobs/slurm_cluster.sh stop      stop the daemons this script started
-#   tests/jobs/slurm_cluster.sh status    exit 0 when the cluster answers with its node idle or busy
+#   tests/launchers/slurm_cluster.sh stop      stop the daemons this script started
+#   tests/launchers/slurm_cluster.sh status    exit 0 when the cluster answers with its node idle or busy
 #
 # What it does (see NOTES.md): installs slurm-wlm and munge with apt-get when missing, makes a
 # munge key and starts munged when munge does not work yet, writes a slurm.conf for this host
@@ -89,7 +89,7 @@ start_munge() {
 write_conf() {
   mkdir -p "$dir/state" "$dir/spool"
   cat >"$conf" <<EOF
-# One-node test cluster written by tests/jobs/slurm_cluster.sh
+# One-node test cluster written by tests/launchers/slurm_cluster.sh
 ClusterName=superball
 SlurmctldHost=$host
 SlurmctldPort=$port

@@ -1,10 +1,10 @@
 #!/usr/bin/python3
 """jobs/slurm/explore.sbatch on a real one-node Slurm cluster started on this machine
-(tests/jobs/slurm_cluster.sh): a small job completes; a job stopped by SIGTERM leaves an
+(tests/launchers/slurm_cluster.sh): a small job completes; a job stopped by SIGTERM leaves an
 incomplete, resumable file that a resubmission finishes, identical to a direct run.
 
 Run by ctest (SUPERBALL = the built binary, SUPERBALL_SOURCE_DIR = the repository), or by hand:
-  SUPERBALL=build/release/src/superball /usr/bin/python3 tests/jobs/test_slurm.py -v
+  SUPERBALL=build/release/src/superball /usr/bin/python3 tests/launchers/test_slurm.py -v
 Skipped only when Slurm cannot run here (not root, packages cannot be installed). The cluster
 is stopped at the end when this test started it; SUPERBALL_KEEP_SLURM=1 keeps it running.
 """
@@ -21,10 +21,11 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import superball_binary, wall_impacts_per_second  # noqa: E402
 
 SOURCE = os.path.abspath(os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", ".."))
-CLUSTER = os.path.join(SOURCE, "tests", "jobs", "slurm_cluster.sh")
+CLUSTER = os.path.join(SOURCE, "tests", "launchers", "slurm_cluster.sh")
 SBATCH_SCRIPT = os.path.join(SOURCE, "jobs", "slurm", "explore.sbatch")
 TIMEOUT = 180  # seconds for any one job to start and end
 
@@ -263,4 +264,4 @@ class SlurmExplore(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

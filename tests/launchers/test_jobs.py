@@ -3,7 +3,7 @@
 seconds to a complete result, and the launch scripts answer --help.
 
 Run by ctest (SUPERBALL = the built binary, SUPERBALL_SOURCE_DIR = the repository), or by hand:
-  SUPERBALL=build/release/src/superball /usr/bin/python3 tests/jobs/test_jobs.py -v
+  SUPERBALL=build/release/src/superball /usr/bin/python3 tests/launchers/test_jobs.py -v
 """
 
 import functools
@@ -19,6 +19,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import superball_binary, mpi_env  # noqa: E402
 
 SOURCE = os.path.abspath(os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.join(os.path.dirname(__file__), "..", ".."))
@@ -194,4 +195,4 @@ class Scripts(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    unittest.main()
+    superball_testing_main()

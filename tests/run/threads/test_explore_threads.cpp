@@ -19,7 +19,7 @@
 #include "job/job.hpp"
 #include "job/provenance.hpp"
 #include "run/explore_threads.hpp"
-#include "../temp_dir.hpp"
+#include "../../temp_dir.hpp"
 
 namespace superball {
 namespace {
