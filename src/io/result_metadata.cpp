@@ -31,6 +31,8 @@ h5::Id create_doubles(hid_t file, const std::string& name, const std::vector<hsi
 
 hid_t count_type(const Job& job) { return job.max_bounces > 65535 ? H5T_STD_U32LE : H5T_STD_U16LE; }
 
+std::size_t count_bytes(const Job& job) { return H5Tget_size(count_type(job)); }
+
 ResultInfo result_info(const Job& job, const Grid& grid)
 {
     ResultInfo info;

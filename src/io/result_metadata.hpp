@@ -2,6 +2,7 @@
 // (io/layout.hpp), and the descriptive attributes of the data.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -41,6 +42,8 @@ void write_run_figures(hid_t file, const RunFigures& run);
 
 // The HDF5 type of the counts of a job: 16 bits unless max_bounces needs more.
 hid_t count_type(const Job& job);
+// Its size in bytes (2 or 4), for callers outside io/ that compare it with a file's.
+std::size_t count_bytes(const Job& job);
 
 // What a result of `job` says about itself (the reader's ResultInfo) as write_metadata
 // writes it: for a writer that must describe its file without reading it back.

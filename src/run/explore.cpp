@@ -88,13 +88,13 @@ Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const
     // The resume writes tiles at offsets computed from the job's grid: a file whose data
     // disagree with its own fingerprint is not written to.
     const Extent shape = Grid(job).shape();
-    const std::size_t count_bytes = H5Tget_size(count_type(job));
-    if (info.shape != shape || info.count_bytes != count_bytes) {
+    const std::size_t bytes = count_bytes(job);
+    if (info.shape != shape || info.count_bytes != bytes) {
         return refuse(fmt::format("{} is damaged: its data ({}, {}-bit counts) contradict its job_fingerprint ({}, {}-bit "
                                   "counts); refusing to resume onto it: --overwrite to start again, or --output to write "
                                   "elsewhere",
                                   partial.string(), fmt::join(info.shape, " x "), 8 * info.count_bytes,
-                                  fmt::join(shape, " x "), 8 * count_bytes));
+                                  fmt::join(shape, " x "), 8 * bytes));
     }
     if (info.software_version != software_version) {
         return refuse(fmt::format("{} was made by superball {}, this is {}; refusing to mix results of two versions: use "
