@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <functional>
 #include <cstring>
 #include <cmath>
 #include <map>
@@ -397,55 +398,78 @@ TEST(ScheduleOneLevel, BlocksShrinkAndAreFew)
     EXPECT_LE(r.result.stats.requests_in, blocks.size() + p) << "one request per block, one more per rank";
 }
 
-// The first eighth of the tiles costs 8 ms, the rest nothing, so the first block (half a
+// Tiles for which `costly` holds take `steps` sleeps of `step_ms`, answering messages
+// between them; the others cost nothing and do not even call serve (with more ranks than
+// cores, Open MPI yields the core in every probe, which would make them costly too).
+class CostlyTiles final : public TileWork {
+public:
+    CostlyTiles(std::function<bool(std::uint64_t)> costly, int steps, int step_ms)
+        : costly_(std::move(costly)), steps_(steps), step_ms_(step_ms)
+    {
+    }
+    void compute(std::uint64_t tile, const Serve& serve) override
+    {
+        const bool costly = costly_(tile);
+        for (int i = 0; costly && i < steps_; ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(step_ms_));
+            if (serve) serve();
+        }
+        if (costly) ++costly_tiles;
+        done_.push_back({tile, checksum_of(tile)});
+    }
+    Flushed flush() override { return {std::exchange(done_, {}), {}}; }
+    std::uint64_t costly_tiles = 0;
+
+private:
+    std::function<bool(std::uint64_t)> costly_;
+    int steps_;
+    int step_ms_;
+    std::vector<TileReport> done_;
+};
+
+struct CostlyRun {
+    ScheduleResult result;
+    std::uint64_t most = 0;  // the most costly tiles one rank computed
+};
+
+// Tiles 0 to n - 1 in order, every one reported once, none interrupted.
+CostlyRun run_costly(std::uint64_t n, CostlyTiles& work, const ScheduleSettings& settings)
+{
+    std::uint64_t reported = 0;
+    const TilesDone done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte>) { reported += tiles.size(); };
+    CostlyRun r{run_schedule(world, iota(n), work, done, [] { return false; }, settings)};
+    EXPECT_FALSE(r.result.interrupted);
+    if (world.is_root()) {
+        EXPECT_EQ(reported, n);
+    }
+    mpi::check(MPI_Allreduce(&work.costly_tiles, &r.most, 1, MPI_UINT64_T, MPI_MAX, world.get()), "MPI_Allreduce");
+    return r;
+}
+
+int computing_ranks(const Mode& m)
+{
+    const int ranks = world.size();
+    return ranks - (m.dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
+}
+
+// The first eighth of the tiles costs 32 ms, the rest nothing, so the first block (half a
 // rank's share of tiles) holds all of the work: the ranks that run out of blocks take the
 // unstarted tiles others hold (all but their next), and the costly tiles end up shared. (Counted, not
 // timed: this machine's load makes times vary.)
 TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
 {
-    const int ranks = world.size();
-    const int computing = ranks - (GetParam().dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
+    const int computing = computing_ranks(GetParam());
     const std::uint64_t n = 100 * static_cast<std::uint64_t>(computing);
-    const std::vector<std::uint64_t> pending = iota(n);
-    class Clustered final : public TileWork {
-    public:
-        explicit Clustered(std::uint64_t n) : n_(n) {}
-        void compute(std::uint64_t tile, const Serve& serve) override
-        {
-            // Light tiles do not even call serve: with more ranks than cores, Open MPI
-            // yields the core in every probe, which would make them costly too.
-            const bool heavy = 8 * tile < n_;
-            for (int i = 0; heavy && i < 4; ++i) {
-                std::this_thread::sleep_for(std::chrono::milliseconds(2));
-                if (serve) serve();
-            }
-            if (heavy) ++heavy_tiles;
-            done_.push_back({tile, checksum_of(tile)});
-        }
-        Flushed flush() override { return {std::exchange(done_, {}), {}}; }
-        std::uint64_t heavy_tiles = 0;
-
-    private:
-        std::uint64_t n_;
-        std::vector<TileReport> done_;
-    } work(n);
-    std::uint64_t reported = 0;
-    const TilesDone done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte>) { reported += tiles.size(); };
-    const ScheduleResult r = run_schedule(world, pending, work, done, [] { return false; }, settings_of(GetParam()));
-    EXPECT_FALSE(r.interrupted);
-    if (world.is_root()) {
-        EXPECT_EQ(reported, n);
-    }
-    std::uint64_t most = 0;
-    mpi::check(MPI_Allreduce(&work.heavy_tiles, &most, 1, MPI_UINT64_T, MPI_MAX, world.get()), "MPI_Allreduce");
+    CostlyTiles work([n](std::uint64_t tile) { return 8 * tile < n; }, 4, 8);
+    const CostlyRun r = run_costly(n, work, settings_of(GetParam()));
     if (computing < 2) return;  // nobody to share with
     // The first block (half a rank's share, 50 tiles) holds every costly tile: without tiles
     // going back one rank would compute all of them. Shared fairly, each computes
     // heavy / computing; the bound leaves a margin for this machine's load (probes yield the
     // core to other ranks) and still fails if nothing goes back.
     const std::uint64_t heavy = n / 8 + (n % 8 != 0 ? 1 : 0);
-    EXPECT_LE(most, heavy * 3 / 4) << "a rank computed " << most << " of the " << heavy << " costly tiles; it gave back "
-                                   << r.stats.given_back;
+    EXPECT_LE(r.most, heavy * 3 / 4) << "a rank computed " << r.most << " of the " << heavy
+                                     << " costly tiles; it gave back " << r.result.stats.given_back;
 }
 
 // The last two tiles handed out are costly (0.3 s), the rest cost nothing: the rank that
@@ -454,40 +478,11 @@ TEST_P(ScheduleTimed, TilesGoBackWhenCostsCluster)
 // so no rank computes both. (Counted, not timed.)
 TEST_P(ScheduleTimed, TheLastCostlyTilesEndOnDifferentRanks)
 {
-    const int ranks = world.size();
-    const int computing = ranks - (GetParam().dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
-    if (computing < 2) GTEST_SKIP() << "one computing rank: nobody to give a tile to";
-    const std::uint64_t n = 20 * static_cast<std::uint64_t>(computing);
-    class LastTwoCostly final : public TileWork {
-    public:
-        explicit LastTwoCostly(std::uint64_t n) : n_(n) {}
-        void compute(std::uint64_t tile, const Serve& serve) override
-        {
-            const bool costly = tile + 2 >= n_;
-            for (int i = 0; costly && i < 60; ++i) {
-                std::this_thread::sleep_for(std::chrono::milliseconds(5));
-                if (serve) serve();
-            }
-            if (costly) ++costly_tiles;
-            done_.push_back({tile, checksum_of(tile)});
-        }
-        Flushed flush() override { return {std::exchange(done_, {}), {}}; }
-        std::uint64_t costly_tiles = 0;
-
-    private:
-        std::uint64_t n_;
-        std::vector<TileReport> done_;
-    } work(n);
-    std::uint64_t reported = 0;
-    const TilesDone done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte>) { reported += tiles.size(); };
-    const ScheduleResult r = run_schedule(world, iota(n), work, done, [] { return false; }, settings_of(GetParam()));
-    EXPECT_FALSE(r.interrupted);
-    if (world.is_root()) {
-        EXPECT_EQ(reported, n);
-    }
-    std::uint64_t most = 0;
-    mpi::check(MPI_Allreduce(&work.costly_tiles, &most, 1, MPI_UINT64_T, MPI_MAX, world.get()), "MPI_Allreduce");
-    EXPECT_EQ(most, 1u) << "one rank computed both costly tiles, one after the other";
+    if (computing_ranks(GetParam()) < 2) GTEST_SKIP() << "one computing rank: nobody to give a tile to";
+    const std::uint64_t n = 20 * static_cast<std::uint64_t>(computing_ranks(GetParam()));
+    CostlyTiles work([n](std::uint64_t tile) { return tile + 2 >= n; }, 60, 5);
+    EXPECT_EQ(run_costly(n, work, settings_of(GetParam())).most, 1u)
+        << "one rank computed both costly tiles, one after the other";
 }
 
 }  // namespace
