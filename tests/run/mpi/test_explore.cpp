@@ -21,6 +21,7 @@
 #include "job/provenance.hpp"
 #include "mpi/mpi.hpp"
 #include "run/explore.hpp"
+#include "../explore_fixture.hpp"
 #include "run/refine.hpp"
 #include "run/tile_counter.hpp"
 
@@ -59,42 +60,10 @@ private:
     fs::path path_;
 };
 
-Job job_of(const std::string& run = "tile_points = 64", int max_bounces = 1000)
-{
-    return parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 61 }\nU = -1.0\n"
-                     "W = { min = -3.0, max = 3.0, n = 47 }\n[run]\nmax_bounces = " +
-                         std::to_string(max_bounces) + "\n" + run + "\n",
-                     "test job");
-}
-
-struct Data {
-    std::vector<std::uint32_t> counts;
-    std::vector<std::uint8_t> outcomes;
-};
-
-// The whole grid counted point by point by the scalar kernel: no MPI, no tiles, no files.
-Data direct(const Job& job)
-{
-    const Grid grid(job);
-    const Extent shape = grid.shape();
-    const Box all{Extent(shape.size(), 0), shape};
-    Starts starts;
-    grid.starts(all, starts);
-    Data d{std::vector<std::uint32_t>(starts.size()), std::vector<std::uint8_t>(starts.size())};
-    count_each(starts.view(), ModelMatrices::of(job.model), job.max_bounces, d.counts, d.outcomes);
-    return d;
-}
-
-Data read_result(const fs::path& path)
-{
-    const ResultReader reader(path);
-    const ResultInfo& info = reader.info();
-    EXPECT_EQ(info.kind, FileKind::result);
-    const Box all{Extent(info.shape.size(), 0), info.shape};
-    Data d{std::vector<std::uint32_t>(all.points()), std::vector<std::uint8_t>(all.points())};
-    EXPECT_EQ(reader.read(all, d.counts, d.outcomes), 0u);
-    return d;
-}
+using test_support::Data;
+using test_support::direct;
+using test_support::job_of;
+using test_support::read_result;
 
 // Counts rank 0's observer calls.
 class Tally final : public RunObserver {

@@ -20,6 +20,7 @@
 #include "job/provenance.hpp"
 #include "run/explore_threads.hpp"
 #include "../../temp_dir.hpp"
+#include "../explore_fixture.hpp"
 
 namespace superball {
 namespace {
@@ -28,38 +29,10 @@ namespace fs = std::filesystem;
 
 using test_support::TempDir;
 
-Job job_of(const std::string& run)
-{
-    return parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\nxi = { min = 0.0, max = 1.0, n = 61 }\nU = -1.0\n"
-                     "W = { min = -3.0, max = 3.0, n = 47 }\n[run]\nmax_bounces = 1000\n" + run + "\n",
-                     "test job");
-}
-
-struct Data {
-    std::vector<std::uint32_t> counts;
-    std::vector<std::uint8_t> outcomes;
-};
-
-Data direct(const Job& job)
-{
-    const Grid grid(job);
-    const Box all{Extent(grid.shape().size(), 0), grid.shape()};
-    Starts starts;
-    grid.starts(all, starts);
-    Data d{std::vector<std::uint32_t>(starts.size()), std::vector<std::uint8_t>(starts.size())};
-    count_each(starts.view(), ModelMatrices::of(job.model), job.max_bounces, d.counts, d.outcomes);
-    return d;
-}
-
-Data read_result(const fs::path& path)
-{
-    const ResultReader reader(path);
-    EXPECT_EQ(reader.info().kind, FileKind::result);
-    const Box all{Extent(reader.info().shape.size(), 0), reader.info().shape};
-    Data d{std::vector<std::uint32_t>(all.points()), std::vector<std::uint8_t>(all.points())};
-    EXPECT_EQ(reader.read(all, d.counts, d.outcomes), 0u);
-    return d;
-}
+using test_support::Data;
+using test_support::direct;
+using test_support::job_of;
+using test_support::read_result;
 
 class Tally final : public RunObserver {
 public:
