@@ -22,7 +22,6 @@ Runner add_info_command(CLI::App& app)
     auto path = std::make_shared<std::string>();
     sub->add_option("file", *path, "result file (.h5) written by superball explore, or its .partial file")->required();
     return [path] {
-        h5::silence_errors();
         std::filesystem::path p = *path;
         std::error_code ec;
         const bool unfinished = !std::filesystem::exists(p, ec) && std::filesystem::exists(layout::partial_path(p), ec);

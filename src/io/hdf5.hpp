@@ -11,76 +11,16 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "hdf5_id.hpp"
+
+static_assert(std::is_same_v<hid_t, std::int64_t> && std::is_same_v<herr_t, int>,
+              "hdf5_id.hpp declares hid_t and herr_t as this HDF5 does");
+
 namespace superball::h5 {
-
-// An HDF5 call failed (I/O, a damaged file, the library).
-struct Error : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-// The innermost message of HDF5's error stack for the last failed call (the stack is
-// silenced, not printed), e.g. "truncated file: eof = ..."; "" if there is none.
-std::string error_detail();
-
-// Throws Error(what) when an HDF5 call reported failure (negative return), with HDF5's
-// own reason in parentheses.
-template <class R>
-R check(R r, std::string_view what)
-{
-    if (r < 0) {
-        const std::string detail = error_detail();
-        throw Error("HDF5: " + std::string(what) + " failed" + (detail.empty() ? "" : " (" + detail + ")"));
-    }
-    return r;
-}
-
-// One identifier and the function that releases it.
-class Id {
-public:
-    using Closer = herr_t (*)(hid_t);
-
-    Id() = default;
-    Id(hid_t id, Closer close, std::string_view what) : id_(check(id, what)), close_(close) {}
-    Id(Id&& o) noexcept : id_(std::exchange(o.id_, H5I_INVALID_HID)), close_(o.close_) {}
-    Id& operator=(Id&& o) noexcept
-    {
-        if (this != &o) {
-            reset();
-            id_ = std::exchange(o.id_, H5I_INVALID_HID);
-            close_ = o.close_;
-        }
-        return *this;
-    }
-    Id(const Id&) = delete;
-    Id& operator=(const Id&) = delete;
-    ~Id() { reset(); }
-
-    hid_t get() const { return id_; }
-    operator hid_t() const { return id_; }  // NOLINT: passed straight to the C API
-    bool valid() const { return id_ >= 0; }
-
-    // Gives the identifier up without closing it (a parallel file must not be closed by
-    // one rank alone when the others are not in step).
-    hid_t release() { return std::exchange(id_, H5I_INVALID_HID); }
-
-    // Closes now and reports failure (a destructor cannot).
-    void close()
-    {
-        if (id_ >= 0) check(close_(std::exchange(id_, H5I_INVALID_HID)), "close");
-    }
-
-private:
-    void reset()
-    {
-        if (id_ >= 0) close_(std::exchange(id_, H5I_INVALID_HID));
-    }
-
-    hid_t id_ = H5I_INVALID_HID;
-    Closer close_ = nullptr;
-};
 
 inline Id file_id(hid_t id, std::string_view what) { return {id, H5Fclose, what}; }
 inline Id group_id(hid_t id, std::string_view what) { return {id, H5Gclose, what}; }

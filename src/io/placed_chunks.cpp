@@ -1,5 +1,7 @@
 #include "placed_chunks.hpp"
 
+#include "hdf5.hpp"
+
 #include <H5FDpublic.h>
 #include <fcntl.h>
 #include <fmt/core.h>

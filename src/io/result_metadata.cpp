@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "hdf5.hpp"
 #include "layout.hpp"
 #include "superball/version.hpp"
 

@@ -14,6 +14,7 @@
 
 #include "job/job.hpp"
 #include "chunk_codec.hpp"
+#include "hdf5.hpp"
 #include "layout.hpp"
 #include "stored_tiles.hpp"
 
@@ -218,6 +219,9 @@ private:
 // Opens `path` read-only, saying what it is when it is not HDF5 at all.
 h5::Id open_hdf5(const fs::path& path)
 {
+    // Failures are reported as FormatError and h5::Error, each saying what failed: HDF5's
+    // own printout of its error stack would only add noise on stderr.
+    h5::silence_errors();
     const std::string p = path.string();
     std::error_code ec;
     if (!fs::exists(path, ec)) throw FormatError(p + ": no such file");

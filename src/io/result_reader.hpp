@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "core/input.hpp"
-#include "hdf5.hpp"
+#include "hdf5_id.hpp"
 #include "job/tiles.hpp"
 #include "posix_file.hpp"
 #include "stored_tiles.hpp"

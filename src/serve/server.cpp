@@ -22,7 +22,6 @@
 #include "core/kernels.hpp"
 #include "core/report.hpp"
 #include "core/trajectory.hpp"
-#include "io/hdf5.hpp"
 #include "job/provenance.hpp"
 #include "layers.hpp"
 #include "pool.hpp"
@@ -495,7 +494,6 @@ void serve(const ServeSettings& settings, const std::function<void(const std::st
     if (settings.port < 0 || settings.port > 65535) {
         throw InputError("--port = " + std::to_string(settings.port) + " is out of range: accepted 0 (any free port) to 65535");
     }
-    h5::silence_errors();
     // Signals to this thread and every thread it starts are blocked: SIGINT and SIGTERM
     // are taken by sigtimedwait below, SIGPIPE (a write to a client that left) is dropped.
     sigset_t signals;
