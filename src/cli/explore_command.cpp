@@ -16,7 +16,7 @@
 #include "job/job.hpp"
 #include "mpi/mpi.hpp"
 #include "run/explore.hpp"
-#include "run/progress.hpp"
+#include "cli/terminal_progress.hpp"
 #include "run/signals.hpp"
 
 namespace superball::cli {

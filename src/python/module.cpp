@@ -30,7 +30,7 @@
 #include "job/provenance.hpp"
 #include "run/count_threads.hpp"
 #include "run/explore_threads.hpp"
-#include "run/progress.hpp"
+#include "cli/terminal_progress.hpp"
 #include "bindings.hpp"
 #include "superball/version.hpp"
 
