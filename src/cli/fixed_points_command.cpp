@@ -2,6 +2,9 @@
 // motions), by Newton's method from many seeded starts, split across MPI ranks.
 #include <fmt/core.h>
 
+#include <complex>
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cstdint>
 #include <memory>
@@ -64,35 +67,28 @@ void write_table(std::FILE* f, const std::vector<Cycle>& cycles, const Model& mo
     }
 }
 
-// Doubles as the shortest text that reads back to the same value (fmt's "{}").
+// JSON through nlohmann-json: doubles as the shortest text that reads back to the same value.
 void write_json(std::FILE* f, const std::vector<Cycle>& cycles, const Model& model, const FixedPointOptions& opt,
                 int ranks)
 {
-    fmt::print(f, "{{\n  \"model\": {{\"e_wall\": {}, \"alpha_wall\": {}, \"e_floor\": {}, \"alpha_floor\": {}}},\n",
-               model.wall.e, model.wall.alpha, model.floor.e, model.floor.alpha);
-    fmt::print(f, "  \"max_period\": {}, \"starts\": {}, \"seed\": {}, \"corner_search\": {}, \"ranks\": {},\n",
-               opt.period, opt.starts, opt.seed, opt.corner, ranks);
-    fmt::print(f, "  \"residual_tolerance\": {}, \"marginal_tolerance\": {},\n  \"cycles\": [", residual_tolerance,
-               marginal_tolerance);
-    const char* sep = "\n";
+    using Json = nlohmann::ordered_json;
+    Json out;
+    out["model"] = {{"e_wall", model.wall.e}, {"alpha_wall", model.wall.alpha}, {"e_floor", model.floor.e},
+                    {"alpha_floor", model.floor.alpha}};
+    out.update({{"max_period", opt.period}, {"starts", opt.starts}, {"seed", opt.seed}, {"corner_search", opt.corner},
+                {"ranks", ranks}, {"residual_tolerance", residual_tolerance}, {"marginal_tolerance", marginal_tolerance}});
+    out["cycles"] = Json::array();
     for (const Cycle& c : cycles) {
         const CanonicalState<double>& p = c.points.front();
-        fmt::print(f, "{}    {{\"period\": {}, \"xi\": {}, \"U\": {}, \"W\": {}, \"lambda\": {}, \"stability\": \"{}\", "
-                      "\"family\": {}, \"corner\": {}, \"residual\": {},\n",
-                   sep, c.period, p.xi, p.U, p.W, c.lambda, name(c.stability), c.family, c.corner, c.residual);
-        fmt::print(f, "     \"eigenvalues\": [");
-        for (std::size_t i = 0; i < c.eigenvalues.size(); ++i) {
-            fmt::print(f, "{}{{\"re\": {}, \"im\": {}}}", i ? ", " : "", c.eigenvalues[i].real(), c.eigenvalues[i].imag());
-        }
-        fmt::print(f, "],\n     \"points\": [");
-        for (std::size_t i = 0; i < c.points.size(); ++i) {
-            fmt::print(f, "{}{{\"xi\": {}, \"U\": {}, \"W\": {}}}", i ? ", " : "", c.points[i].xi, c.points[i].U,
-                       c.points[i].W);
-        }
-        fmt::print(f, "]}}");
-        sep = ",\n";
+        Json cycle = {{"period", c.period}, {"xi", p.xi}, {"U", p.U}, {"W", p.W}, {"lambda", c.lambda},
+                      {"stability", name(c.stability)}, {"family", c.family}, {"corner", c.corner}, {"residual", c.residual}};
+        cycle["eigenvalues"] = Json::array();
+        for (const std::complex<double>& z : c.eigenvalues) cycle["eigenvalues"].push_back({{"re", z.real()}, {"im", z.imag()}});
+        cycle["points"] = Json::array();
+        for (const CanonicalState<double>& q : c.points) cycle["points"].push_back({{"xi", q.xi}, {"U", q.U}, {"W", q.W}});
+        out["cycles"].push_back(std::move(cycle));
     }
-    fmt::print(f, "\n  ]\n}}\n");
+    fmt::print(f, "{}\n", out.dump(1));
 }
 
 int run(const FixedPointOptions& opt)
