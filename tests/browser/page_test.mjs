@@ -95,6 +95,12 @@ try {
   await page.waitForFunction(() => window.explorer && window.explorer.map);
   const first = await mapState();
   report.initial = { ...first, tiles: await tilesLoaded(first.zoom) };
+  // The first view shows the whole window (map units [-256, 0] x [0, 256]) in the map's
+  // final size.
+  report.initial.fits = await page.evaluate(() => {
+    const b = window.explorer.map.getBounds();
+    return b.contains([[-256, 0], [0, 256]]);
+  });
   check(report.initial.tiles.loaded > 0 && report.initial.tiles.loaded === report.initial.tiles.all,
         "tiles did not load: " + JSON.stringify(report.initial.tiles));
   const mapBox = await (await page.$("#map")).boundingBox();
@@ -144,6 +150,31 @@ try {
   report.readout = {
     text: await page.$eval("#readout", (e) => e.textContent),
     start: await page.evaluate(() => window.explorer.readoutStart),
+    // The pixels of the tile image under the pointer (it and its 8 neighbours), read back
+    // from the image itself through a canvas (same origin), as #rrggbb.
+    pixels: await page.evaluate((x, y) => {
+      // Tiles take no pointer events (elementsFromPoint passes them by): the loaded tile of
+      // the current zoom whose box holds the point.
+      const zoom = window.explorer.map.getZoom();
+      const img = [...document.querySelectorAll(".leaflet-tile-container img.leaflet-tile-loaded")].find((e) => {
+        const b = e.getBoundingClientRect();
+        return e.src.includes(`/tile/${zoom}/`) && x >= b.left && x < b.right && y >= b.top && y < b.bottom;
+      });
+      if (!img) return null;
+      const r = img.getBoundingClientRect();
+      const canvas = document.createElement("canvas");
+      canvas.width = img.naturalWidth;
+      canvas.height = img.naturalHeight;
+      const ctx = canvas.getContext("2d");
+      ctx.drawImage(img, 0, 0);
+      const ix = Math.floor((x - r.left) * img.naturalWidth / r.width), iy = Math.floor((y - r.top) * img.naturalHeight / r.height);
+      const hex = (d) => "#" + [d[0], d[1], d[2]].map((v) => v.toString(16).padStart(2, "0")).join("");
+      const out = [];
+      for (let dy = -1; dy <= 1; ++dy) {
+        for (let dx = -1; dx <= 1; ++dx) out.push(hex(ctx.getImageData(ix + dx, iy + dy, 1, 1).data));
+      }
+      return out;
+    }, mapBox.x + p.x, mapBox.y + p.y),
   };
 
   // Click: the trajectory is drawn and the ball moves.

@@ -18,6 +18,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+import urllib.request
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
@@ -25,6 +26,14 @@ from superball_testing import main as superball_testing_main  # noqa: E402
 from superball_testing import Server, superball_binary  # noqa: E402
 
 BINARY = superball_binary()
+
+
+def legend_colour(legend, label):
+    """The colour of the legend's entry `label` ("N = 8")."""
+    for entry in legend["entries"]:
+        if entry["label"] == label:
+            return entry["colour"]
+    raise AssertionError(f"no legend entry {label!r} in {legend}")
 
 
 def count(start, *model):
@@ -46,6 +55,8 @@ class BrowserTest(unittest.TestCase):
                                capture_output=True, text=True, timeout=300)
             self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
             report = json.loads(r.stdout)
+            with urllib.request.urlopen(server.url.rstrip("/") + "/api/legend", timeout=60) as answer:
+                legend = json.load(answer)
         self.assertEqual(report["errors"], [])
         self.assertEqual(report["message"], "")
 
@@ -73,6 +84,16 @@ class BrowserTest(unittest.TestCase):
         expected = count(start, *model)
         self.assertIn(f"N  = {expected['wall_bounces']} wall bounce", readout)
         self.assertTrue(readout.rstrip().endswith(expected["outcome"]), readout)
+        # ... and the map's pixel there has the colour the legend gives that count (the
+        # page's default colouring); the probe lies inside a region, not on a boundary.
+        pixels = report["readout"]["pixels"]
+        self.assertIsNotNone(pixels, "no map tile under the probe")
+        self.assertEqual(len(set(pixels)), 1, f"the probe is on a boundary of regions, move it: {pixels}")
+        self.assertEqual(pixels[4], legend_colour(legend, f"N = {expected['wall_bounces']}"),
+                         f"the map shows {pixels[4]} where the readout says N = {expected['wall_bounces']}")
+
+        # The first view held the whole window.
+        self.assertTrue(report["initial"]["fits"], report["initial"])
 
         # The trajectory of the clicked launch.
         trajectory = report["trajectory"]
