@@ -71,7 +71,7 @@ for script, args in json.load(sys.stdin):
         except BaseException:
             status = "traceback"
             err.write(traceback.format_exc())
-    results.append({"status": status, "stderr": err.getvalue()})
+    results.append({"status": status, "stdout": out.getvalue(), "stderr": err.getvalue()})
 json.dump(results, sys.stdout)
 """
 
@@ -482,9 +482,10 @@ class Damaged(unittest.TestCase):
 
     def test_one_byte_overwritten_anywhere(self):
         """A byte overwritten at offsets across each file: every reader either reads the
-        file (the byte was in space no object uses, or a tile not done) or refuses it with
-        exit 2; never a crash, a traceback or a hang."""
-        cases = []
+        file as it was (the byte was in space no object uses, or in a tile not done: what it
+        prints is what it prints of the undamaged file) or refuses it with exit 2; never a
+        crash, a traceback, a hang or wrong numbers."""
+        cases = [(f"undamaged {base}", base, lambda path: None, "") for base in "RP"]
         for base, source in (("R", self.result), ("P", self.partial)):
             size = os.path.getsize(source)
             for offset in np.linspace(0, size - 1, 24).astype(int):
@@ -503,14 +504,27 @@ class Damaged(unittest.TestCase):
         refused = 0
         with ThreadPoolExecutor(max_workers=2) as pool:
             infos = list(pool.map(lambda f: self.run_binary("info", f[1]), files))
-        for (what, *_), r, s in zip(cases, infos, json.loads(driver.stdout)):
+        summaries = json.loads(driver.stdout)
+        # What each reader prints of the undamaged files (the first two cases), with the
+        # file's name taken out.
+        def printed(text, path):
+            return text.replace(path, "FILE")
+        expected = {cases[k][1]: (printed(infos[k].stdout, files[k][1]), printed(summaries[k]["stdout"], files[k][1]))
+                    for k in (0, 1)}
+        for k in (0, 1):
+            self.assertEqual((infos[k].returncode, summaries[k]["status"]), (0, 0), cases[k][0])
+        for (what, base, *_), (_, path), r, s in list(zip(cases, files, infos, summaries))[2:]:
             with self.subTest(what):
                 self.assertIn(r.returncode, (0, 2), r.stderr)
                 self.assertIn(s["status"], (0, 2), s["stderr"])
+                if r.returncode == 0:
+                    self.assertEqual(printed(r.stdout, path), expected[base][0], "info read the damaged file wrong")
+                if s["status"] == 0:
+                    self.assertEqual(printed(s["stdout"], path), expected[base][1], "summary.py read the damaged file wrong")
                 if r.returncode == 2:
                     refused += 1
                     self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
-        self.assertGreater(refused, len(cases) // 3)
+        self.assertGreater(refused, (len(cases) - 2) // 3)
 
 
 class Overwrite(unittest.TestCase):
