@@ -28,7 +28,9 @@ struct BasicImpactMatrix {
     S c_Ws;    // (5/7)(1 + alpha): tangential velocity fed into the spin
     S c_WW;    // (2 - 5 alpha)/7: spin kept
 
-    friend constexpr bool operator==(const BasicImpactMatrix&, const BasicImpactMatrix&) = default;
+    // Not declared constexpr: a defaulted comparison is constexpr where S allows it, and
+    // declaring it so is an error for the S that do not (clang).
+    friend bool operator==(const BasicImpactMatrix&, const BasicImpactMatrix&) = default;
 
     static constexpr BasicImpactMatrix of(const S& e, const S& alpha)
     {
@@ -45,7 +47,7 @@ struct BasicModelMatrices {
     BasicImpactMatrix<S> wall;
     BasicImpactMatrix<S> floor;
 
-    friend constexpr bool operator==(const BasicModelMatrices&, const BasicModelMatrices&) = default;
+    friend bool operator==(const BasicModelMatrices&, const BasicModelMatrices&) = default;  // constexpr where S allows
 
     static constexpr BasicModelMatrices of(const Model& m)
     {

@@ -240,7 +240,7 @@ h5::Id open_hdf5(const fs::path& path)
 // open is judged so; one it opens is superball's by its attributes.
 bool has_superball_marks(const fs::path& path, std::uint64_t size)
 {
-    constexpr std::uint64_t span = 64 * 1024;
+    constexpr std::uint64_t span = std::uint64_t{64} * 1024;
     std::ifstream in(path, std::ios::binary);
     std::string bytes;
     for (const std::uint64_t at : {std::uint64_t{0}, size > span ? size - span : std::uint64_t{0}}) {
@@ -513,8 +513,9 @@ void ResultReader::validate()
     }
     for (const std::string& a : in.axis_names) {
         if (is_coefficient(a) && !swept.count(a)) {
-            check.fail("attribute axis_names names the coefficient " + a + ", but no coefficient attribute says \"axis:" + a +
-                       "\"");
+            check.fail(fmt::format("attribute axis_names names the coefficient {0}, but no coefficient attribute says "
+                                   "\"axis:{0}\"",
+                                   a));
         }
     }
     if (in.coordinate_system == "physical") {

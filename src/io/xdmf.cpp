@@ -50,15 +50,16 @@ std::vector<MeshAxis> mesh_axes(const ResultInfo& info)
     const std::vector<std::string> order = info.coordinate_system == "canonical"
                                                ? std::vector<std::string>{"xi", "U", "W"}
                                                : std::vector<std::string>{"x", "u", "v", "omega"};
-    for (const auto& [name, value] : info.fixed) {
+    const auto rank = [&](const std::string& n) {
+        const auto it = std::find(order.begin(), order.end(), n);
+        return it == order.end() ? -1 : static_cast<int>(it - order.begin());
+    };
+    for (const auto& fixed : info.fixed) {
         if (axes.size() == 3) break;
         // Before the first data axis that is a coordinate coming after it.
-        const auto rank = [&](const std::string& n) {
-            const auto it = std::find(order.begin(), order.end(), n);
-            return it == order.end() ? -1 : static_cast<int>(it - order.begin());
-        };
-        auto at = std::find_if(axes.begin(), axes.end(), [&](const MeshAxis& a) { return rank(a.name) > rank(name); });
-        axes.insert(at, {name, -1, 1, value});
+        const int after = rank(fixed.first);
+        auto at = std::find_if(axes.begin(), axes.end(), [&](const MeshAxis& a) { return rank(a.name) > after; });
+        axes.insert(at, {fixed.first, -1, 1, fixed.second});
     }
     return axes;
 }
@@ -79,7 +80,7 @@ std::filesystem::path write_xdmf(const std::filesystem::path& result, const Resu
 {
     if (!xdmf_unsupported(result, info).empty()) return {};
     const std::vector<MeshAxis> axes = mesh_axes(info);
-    const std::filesystem::path out = layout::sidecar_path(result);
+    std::filesystem::path out = layout::sidecar_path(result);  // returned: not const, so it moves
     const std::string h5 = xml_escape(result.filename().string());
     const std::string mesh_dims = fmt::format("{} {} {}", axes[0].n, axes[1].n, axes[2].n);
 

@@ -384,6 +384,7 @@ PYBIND11_MODULE(_core, m)
     using namespace superball;
     m.doc() = "The compiled part of superball: use the package superball, which documents every function.";
     // InputError (and FormatError): bad input, naming the argument or the file.
+    // NOLINTNEXTLINE(performance-unnecessary-value-param): pybind11 takes a void(*)(std::exception_ptr)
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);

@@ -328,7 +328,15 @@ void check_bounds(Parameter p, const std::optional<double>& lo, const std::optio
 {
     const std::string range = parameter_range_text(p);
     for (const auto& [key, value] : {std::pair{&lo_key, lo}, std::pair{&hi_key, hi}}) {
-        if (!value) throw InputError(*key + " is not set: give the bounds of " + p_name + " (accepted " + range + ")");
+        if (!value) {
+            std::string message = *key;  // built with +=: one allocation, not one per piece
+            message += " is not set: give the bounds of ";
+            message += p_name;
+            message += " (accepted ";
+            message += range;
+            message += ")";
+            throw InputError(message);
+        }
         if (!parameter_in_range(p, *value)) {
             throw InputError(*key + " = " + format_double(*value) + " is out of range: accepted " + range);
         }

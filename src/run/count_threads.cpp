@@ -13,7 +13,7 @@ std::size_t count_block(std::size_t n, unsigned threads)
     // About 8 blocks per thread, so that the slowest block costs the others little at the
     // end; at least 4096 points (a few microseconds of scheduling on 30-100 us of counting),
     // at most 2^18 (the vector kernel's drain at the end of a block is then negligible).
-    const std::size_t per = n / (8 * std::max(1u, threads));
+    const std::size_t per = n / (std::size_t{8} * std::max(1u, threads));
     return std::clamp<std::size_t>(per, 4096, std::size_t{1} << 18);
 }
 

@@ -144,7 +144,7 @@ bool is_superball_sidecar(const fs::path& path)
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) return false;
     std::ifstream in(path, std::ios::binary);
-    std::string head(64 * 1024, '\0');
+    std::string head(std::size_t{64} * 1024, '\0');
     in.read(head.data(), static_cast<std::streamsize>(head.size()));
     head.resize(static_cast<std::size_t>(in.gcount()));
     return head.rfind("<?xml", 0) == 0 && head.find("<Xdmf") != std::string::npos &&

@@ -116,7 +116,7 @@ std::optional<std::int64_t> Query::integer(std::string_view key, std::int64_t lo
 
 std::optional<std::string> Query::choice(std::string_view key, const std::vector<std::string>& choices)
 {
-    const std::optional<std::string> value = text(key);
+    std::optional<std::string> value = text(key);  // returned: not const, so it moves
     if (!value) return std::nullopt;
     for (const std::string& c : choices) {
         if (*value == c) return value;
