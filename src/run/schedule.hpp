@@ -1,137 +1,15 @@
-// Dynamic schedule of tiles over MPI ranks.
-//
-// The cost of a point varies by orders of magnitude across a grid (one bounce near the
-// edges, up to max_bounces near self-similar motions), so tiles are handed out on
-// demand rather than split statically, in blocks of consecutive tiles whose size shrinks
-// as the work runs out (guided self-scheduling, a block being remaining / (2 ranks)):
-// the scheduler answers O(P log(N/P)) requests for N tiles on P ranks, not N, and the
-// last blocks are single tiles so the ranks finish together. Results never depend on the
-// schedule: every tile is computed the same way wherever it runs.
-//
-// Who serves whom:
-// - every rank that computes keeps its next block queued: it asks for one when it starts
-//   the block before, so it never waits on a round trip;
-// - rank 0 hands out blocks. Below `dedicated_root_ranks` ranks it computes too and
-//   answers between blocks of points (the Serve callback); from there on it only
-//   schedules;
-// - across nodes (more than one node, found with MPI_Comm_split_type), rank 0 hands big
-//   blocks to one leader per node, which sub-divides them among its node's ranks and
-//   forwards their reports, so no process serves more than its node's requests plus one
-//   message per leader (see docs/running.md, "Running on a cluster");
-// - at the end, ranks holding unstarted tiles give them back for the ranks out of work:
-//   within a node through its leader, across nodes through rank 0.
-// The order of `pending` is the caller's (job/tiles.hpp, handout_order: interleaved from
-// 64 ranks on, so that a block's cost follows its size).
+// The work pool (work_pool.hpp) over MPI: which ranks serve which, found with
+// MPI_Comm_split_type (one leader per node when the ranks span several nodes), and the
+// messages between them.
 #pragma once
 
-#include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <span>
-#include <vector>
 
-#include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
+#include "run/work_pool.hpp"
 
 namespace superball {
-
-// Called from inside a rank's work every `points` points counted: a rank that serves
-// others answers them (blocks, tiles back), a served rank its server's requests for tiles
-// back. Empty on a rank alone (nobody to answer).
-struct Serve {
-    std::function<void()> call;
-    // Points counted between two calls. A rank serving many ranks answers more often: at
-    // 4096 simulated ranks, node leaders answering every 512 points (up to 0.1 s on the
-    // costliest tiles) left every rank waiting 3.2 s on average, every 64 points 0.7 s
-    // (tests/scale); smaller blocks cost the server a little of its own counting speed.
-    std::size_t points = 512;
-
-    explicit operator bool() const { return static_cast<bool>(call); }
-    void operator()() const { call(); }
-};
-
-// What a rank hands over when it flushes: the reports of the tiles it finished since the
-// last flush, in the order it computed them, and, when their data travel with the reports
-// to rank 0 (compressed tiles, for rank 0's writer), those data.
-struct Flushed {
-    std::vector<TileReport> reports;
-    std::vector<std::byte> payload;
-};
-
-// What a rank does with the tiles it is given.
-class TileWork {
-public:
-    virtual ~TileWork() = default;
-    // Counts tile `tile` and hands its data on (to the rank's writer, or to be sent).
-    virtual void compute(std::uint64_t tile, const Serve& serve) = 0;
-    // Hands over every tile computed so far and not yet handed over: either written to the
-    // file (then only a tile reported here may be recorded done), or in the payload for
-    // rank 0, which records them once it has written them.
-    virtual Flushed flush() = 0;
-    // True when what the rank holds should leave now, before the report period is over
-    // (a bound on its memory).
-    virtual bool should_flush() const { return false; }
-};
-
-// Called on rank 0 for finished tiles (see TileWork::flush), with the rank that computed
-// them and the payload that came with them.
-using TilesDone = std::function<void(std::span<const TileReport> tiles, int rank, std::span<const std::byte> payload)>;
-// Polled on every rank between tiles: true on any rank stops the run. Every rank then
-// finishes the tile it is computing, drops the rest of its blocks, writes and reports
-// what it computed, and returns (the run is interrupted).
-using StopRequested = std::function<bool()>;
-
-struct ScheduleSettings {
-    // A rank with finished tiles flushes them and reports them at least this often, so
-    // that the resume journal lags the work by little (node leaders pass reports on
-    // every report_seconds / 2).
-    double report_seconds = 1.0;
-    // Blocks are multiples of this many tiles where they can be (a stripe of the file
-    // system's alignment, so that two ranks' writes do not share one).
-    std::uint64_t granule = 1;
-    // A block is what is left over (block_divisor x ranks), per rank it serves (guided
-    // self-scheduling; at least one tile).
-    std::uint64_t block_divisor = 2;
-    // Points counted between two looks for messages on a rank that serves at least
-    // `busy_server_ranks` ranks (Serve::points; 512 elsewhere).
-    std::size_t server_points = 64;
-    int busy_server_ranks = 4;
-    // With at least this many ranks, rank 0 computes no tile and only schedules (0:
-    // never). Below it, a computing rank 0 loses little: it answers within a few hundred
-    // points and its share of the work is 1/P; from about 64 ranks on its answers are
-    // late often enough, and its share small enough, that one rank is better spent
-    // scheduling.
-    int dedicated_root_ranks = 64;
-    // 0: nodes are the ranks sharing memory (MPI_Comm_split_type). n > 0: pseudo-nodes of
-    // n consecutive ranks, which forces the two-level scheme on one machine (tests), or
-    // names the nodes where MPI_Comm_split_type cannot (SMPI).
-    int node_ranks = 0;
-    // A server with nothing to do (a dedicated rank 0, a leader whose ranks are busy)
-    // sleeps between looks for messages, longer and longer up to this: the delay of its
-    // first answer after a quiet spell, and of its noticing a stop signal. (Idle, it
-    // costs nothing either way; a simulation of hours of cluster time wants fewer looks.)
-    double idle_poll_seconds = 1e-3;
-};
-
-// What one rank saw of the schedule (for tests, benchmarks and the simulation).
-struct ScheduleStats {
-    std::uint64_t tiles = 0;         // tiles this rank computed
-    std::uint64_t blocks = 0;        // blocks it computed
-    std::uint64_t flushes = 0;       // TileWork::flush calls that returned tiles
-    std::uint64_t messages_in = 0;   // messages it received from the ranks it serves
-    std::uint64_t requests_in = 0;   // of which requests for a block
-    std::uint64_t messages_out = 0;  // messages it sent to the rank that serves it
-    std::uint64_t payload_bytes_out = 0;  // bytes of its own tiles' payloads it sent
-    // Sizes of the blocks a server (rank 0, node leaders) took from its pool, for the
-    // ranks it serves and for itself, in order.
-    std::vector<std::uint64_t> handed_out;
-    std::uint64_t given_back = 0;    // tiles it gave back (to its server, or to its own pool)
-    std::uint64_t asked_back = 0;    // requests for tiles back it sent to the ranks it serves
-    double idle_seconds = 0;         // time it waited with nothing to compute (or to serve)
-    bool two_level = false;          // node leaders were used (same on every rank)
-    bool leader = false;             // this rank served a node (rank 0 included)
-    bool computed = false;           // this rank computed tiles (false: a scheduler only)
-};
 
 struct ScheduleResult {
     bool interrupted = false;  // on every rank: tiles were left undone on purpose

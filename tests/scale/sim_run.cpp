@@ -1,4 +1,4 @@
-// The real schedule (src/run/schedule.cpp, over src/mpi/mpi.cpp) under SimGrid's SMPI,
+// The real schedule (src/run/work_pool.cpp over src/run/schedule.cpp and src/mpi/mpi.cpp) under SimGrid's SMPI,
 // with counting and writing replaced by cost models. Compressed (the default): a tile costs
 // what scale_costs computed from a real result of the job, plus its compression at
 // --compress-mbps (smpi_execute, on the rank that counted it); its stored bytes (raw /

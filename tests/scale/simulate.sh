@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Predicts how superball explore scales on a cluster, with SimGrid's SMPI running the real
-# schedule (src/run/schedule.cpp over src/mpi/mpi.cpp, built with smpicxx into
+# schedule (src/run/work_pool.cpp over src/run/schedule.cpp and src/mpi/mpi.cpp, built with smpicxx into
 # OUT/sim_run) and cost models for counting and writing. Prints one line per job and rank
 # count:
 #
