@@ -370,7 +370,20 @@ ResultReader::ResultReader(const fs::path& path) : path_(path), file_(open_hdf5(
     }
 }
 
+// Each part reads what the ones before it validated.
 void ResultReader::validate()
+{
+    validate_kind();
+    validate_axes();
+    validate_job_and_model();
+    validate_no_journal();
+    validate_data();
+    validate_coordinates();
+    if (info_.kind == FileKind::partial) validate_partial();
+}
+
+// What the file is: a superball result or partial file of a format this version reads.
+void ResultReader::validate_kind()
 {
     const Checker check(file_, path_);
     ResultInfo& in = info_;
@@ -417,8 +430,13 @@ void ResultReader::validate()
                                      "that wrote it, this one resumes format {} only",
                                      format, format, layout::format_version));
     }
+}
 
-    // The grid's coordinates and axes.
+// The grid's coordinates and axes: which are ranges (axis_names, in order), which are fixed.
+void ResultReader::validate_axes()
+{
+    const Checker check(file_, path_);
+    ResultInfo& in = info_;
     in.coordinate_system = check.text("coordinate_system");
     if (in.coordinate_system != "canonical" && in.coordinate_system != "physical") {
         check.fail("attribute coordinate_system = \"" + printable(in.coordinate_system) + "\" is neither canonical nor physical");
@@ -453,8 +471,13 @@ void ResultReader::validate()
         check.fail(fmt::format("attribute axis_names lists {} {} coordinates: a grid has at most 3 ranges",
                                coordinates.size() - in.fixed.size(), in.coordinate_system));
     }
+}
 
-    // The job, the run and the model.
+// The job, the run, the provenance and the model's coefficients.
+void ResultReader::validate_job_and_model()
+{
+    const Checker check(file_, path_);
+    ResultInfo& in = info_;
     in.max_bounces = check.integer("max_bounces", 1, max_max_bounces);
     in.software_version = check.text("software_version");
     in.job_toml = check.text("job_toml", max_job_bytes);
@@ -525,8 +548,13 @@ void ResultReader::validate()
             }
         }
     }
+}
 
-    // A result is complete: a resume journal belongs to a run in progress.
+// A result is complete: a resume journal belongs to a run in progress.
+void ResultReader::validate_no_journal()
+{
+    const Checker check(file_, path_);
+    const ResultInfo& in = info_;
     if (in.kind == FileKind::result && h5::object_type(file_, "/progress") != h5::ObjectType::missing) {
         std::string journal;
         if (h5::object_type(file_, layout::tile_done) == h5::ObjectType::dataset) {
@@ -545,8 +573,13 @@ void ResultReader::validate()
                                "journal{}: the file contradicts itself",
                                journal.empty() ? " (/progress), which only a run in progress has" : journal));
     }
+}
 
-    // The data.
+// The data: types, shapes agreeing with the axes, storage.
+void ResultReader::validate_data()
+{
+    const Checker check(file_, path_);
+    ResultInfo& in = info_;
     counts_ = check.dataset(layout::wall_bounces);
     outcomes_ = check.dataset(layout::outcome);
     const h5::Shape cs = h5::dataset_shape_of(counts_);
@@ -591,9 +624,15 @@ void ResultReader::validate()
         check.allocated(counts_, layout::wall_bounces);
         check.allocated(outcomes_, layout::outcome);
     }
+}
 
-    // Coordinate variables: each axis's samples, a dimension scale attached to its
-    // dimension of both datasets (what xarray and netCDF tools read as its coordinate).
+// Coordinate variables: each axis's samples, a dimension scale attached to its dimension of
+// both datasets (what xarray and netCDF tools read as its coordinate); each fixed coordinate
+// a scalar variable agreeing with its attribute.
+void ResultReader::validate_coordinates()
+{
+    const Checker check(file_, path_);
+    const ResultInfo& in = info_;
     const auto attached = [&](hid_t data, const char* data_name) {
         std::vector<std::vector<haddr_t>> scales;
         try {
@@ -642,11 +681,16 @@ void ResultReader::validate()
         h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &x), "read " + v);
         if (!(x == value)) check.fail(fmt::format("{} = {} contradicts attribute fixed_{} = {}", v, x, name, value));
     }
-
-    if (in.kind == FileKind::partial) validate_partial();
 }
 
+// A partial file: its tiles, their storage, then the resume journal.
 void ResultReader::validate_partial()
+{
+    validate_tiles();
+    validate_journal();
+}
+
+void ResultReader::validate_tiles()
 {
     const Checker check(file_, path_);
     ResultInfo& in = info_;
@@ -690,6 +734,13 @@ void ResultReader::validate_partial()
             }
         }
     }
+}
+
+// The journal: which tiles are done, their checksums and (compressed) where their chunks lie.
+void ResultReader::validate_journal()
+{
+    const Checker check(file_, path_);
+    ResultInfo& in = info_;
     std::vector<const char*> journal{layout::tile_done, layout::tile_checksum};
     if (compressed_) journal.push_back(layout::tile_stored);
     for (const char* name : journal) {

@@ -102,7 +102,15 @@ public:
 
 private:
     void validate();
+    void validate_kind();
+    void validate_axes();
+    void validate_job_and_model();
+    void validate_no_journal();
+    void validate_data();
+    void validate_coordinates();
     void validate_partial();
+    void validate_tiles();
+    void validate_journal();
     std::uint64_t read_checked(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const;
     void validate_values(const Box& box, std::span<const std::uint32_t> counts, std::span<const std::uint8_t> outcomes,
                          std::span<const std::uint8_t> computed) const;
