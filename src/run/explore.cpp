@@ -444,6 +444,206 @@ ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings)
     return plan_of(decide_or_refuse(settings, out, job), out);
 }
 
+namespace {
+
+// What rank 0 found or made (start_partial), on every rank; a failure on rank 0 thrown on
+// every rank.
+StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, PlanMode mode, const Job& job,
+                                const Grid& grid, const Provenance& provenance)
+{
+    StartedPartial started;
+    std::int64_t failed = 0;
+    std::string failure;
+    if (comm.is_root()) {
+        try {
+            started = start_partial(partial, mode, job, grid, comm.size(), provenance);
+        } catch (const RunError& e) {
+            failed = 1;
+            failure = e.what();
+        }
+    }
+    if (comm.broadcast(failed) != 0) {
+        comm.broadcast(failure);
+        throw RunError(failure);
+    }
+    comm.broadcast(started.tile_shape);
+    broadcast(comm, started.layout);
+    return started;
+}
+
+// The tiles done (from rank 0's journal, on every rank) and those left to compute. A resume
+// first checks that the done tiles still hold what was written: every rank checks some.
+struct TilesLeft {
+    std::vector<std::uint64_t> done;
+    std::vector<std::uint64_t> pending;
+};
+
+TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& partial, PlanMode mode,
+                     const TileJournal& journal, const PartialLayout& layout, const Tiling& tiling)
+{
+    TilesLeft left;
+    for (std::uint64_t t = 0; t < journal.done.size(); ++t) {
+        if (journal.done[t] != 0) left.done.push_back(t);
+    }
+    comm.broadcast(left.done);
+    if (mode == PlanMode::resume) {
+        std::vector<std::uint64_t> sums, where;  // of the done tiles: rank 0 read them
+        if (comm.is_root()) {
+            for (const std::uint64_t t : left.done) {
+                sums.push_back(journal.checksums[t]);
+                if (layout.compressed) {
+                    const StoredChunk& c = journal.stored[t];
+                    where.insert(where.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
+                }
+            }
+        }
+        comm.broadcast(sums);
+        comm.broadcast(where);
+        std::vector<StoredChunk> stored(where.size() / 3);
+        for (std::size_t i = 0; i < stored.size(); ++i) stored[i] = {where[3 * i], where[3 * i + 1], where[3 * i + 2]};
+        if (const std::vector<std::uint64_t> bad = file.damaged(left.done, sums, stored); !bad.empty()) {
+            file.close();
+            throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
+                                         "checksum written with them; refusing to resume onto it: --overwrite to start "
+                                         "again, or --output to write elsewhere",
+                                         partial.string(), bad.size(), left.done.size(), bad.front()));
+        }
+    }
+    std::uint64_t d = 0;
+    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
+        if (d < left.done.size() && left.done[d] == t) {
+            ++d;
+        } else {
+            left.pending.push_back(t);
+        }
+    }
+    return left;
+}
+
+// Rank 0's record of the run: the tiles done, in the journal, and the compressed ones
+// written (from the end of the file: whatever an interrupted run wrote past its last record
+// stays unused).
+class Recorder {
+public:
+    Recorder(PartialFile& file, const fs::path& partial, TileJournal journal, const Job& job, const PartialLayout& layout,
+             const Tiling& tiling, RunObserver& observer)
+        : partial_(partial), tiling_(tiling), observer_(observer),
+          record_(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds))
+    {
+        if (layout.compressed) appender_.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
+    }
+
+    // TilesDone: the reports of finished tiles, with their compressed data when rank 0 writes them.
+    void done(std::span<const TileReport> tiles, std::span<const std::byte> payload)
+    {
+        if (appender_) {
+            const TileBatch batch = TileBatch::unpack(payload);
+            const std::vector<TileReport> carried = batch.reports();
+            if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
+                    return a.tile == b.tile && a.checksum == b.checksum;
+                })) {
+                throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
+            }
+            appender_->add(batch);
+            recorded(appender_->written());
+        } else {
+            record_.record(tiles);
+            std::uint64_t points = 0;
+            for (const TileReport& r : tiles) points += tiling_.box(r.tile).points();
+            observer_.tiles_done(tiles.size(), points);
+        }
+        if (record_.due()) checkpoint();
+    }
+
+    // The journal written, and, for compressed tiles, every tile written so far recorded
+    // first and then covered by the file's HDF5 end (PlacedChunks::cover): between two
+    // checkpoints the partial file is a consistent HDF5 file holding every tile it records.
+    // (The write in progress is waited for: tiles are recorded once written, and a tile
+    // written a moment ago would otherwise wait a whole report period for the next call.)
+    void checkpoint()
+    {
+        if (appender_) recorded(appender_->flush());
+        if (record_.checkpoint(true) && appender_) PlacedChunks::cover(partial_);
+    }
+
+    // The last tiles of a complete run: the result's figures and index come next, so the
+    // journal needs no cover.
+    void last()
+    {
+        if (appender_) recorded(appender_->flush());
+        record_.checkpoint(true);
+    }
+
+    const Journal& journal() const { return record_; }
+
+private:
+    void recorded(std::span<const AppendedTile> tiles)
+    {
+        record_.record(tiles);
+        std::uint64_t points = 0;
+        for (const AppendedTile& a : tiles) points += tiling_.box(a.tile).points();
+        if (!tiles.empty()) observer_.tiles_done(tiles.size(), points);
+    }
+
+    const fs::path& partial_;
+    const Tiling& tiling_;
+    RunObserver& observer_;
+    Journal record_;
+    std::optional<ChunkAppender> appender_;
+};
+
+// What rank 0 does with the partial file once the tiles are counted: an interrupted run's
+// seconds recorded in it, a complete run's result made from it. A failure on rank 0 is
+// thrown on every rank.
+FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<Recorder>& recorder, bool interrupted,
+                       const fs::path& partial, const Job& job, const Grid& grid, const Tiling& tiling,
+                       const PartialLayout& layout, const Provenance& provenance, const ExplorePlan& plan,
+                       double seconds_before, std::chrono::steady_clock::time_point started, RunObserver& observer)
+{
+    std::int64_t ok = 1;
+    std::string failure;
+    FinishReport finish;
+    if (comm.is_root()) {
+        try {
+            if (interrupted) {
+                recorder->checkpoint();
+            } else {
+                recorder->last();
+            }
+        } catch (const std::exception& e) {
+            ok = 0;
+            failure = e.what();
+        }
+    }
+    // The run's figures, in the partial file (a stop) or the result (complete), by rank 0
+    // alone once every rank has closed the file.
+    file.close();
+    comm.barrier();
+    if (comm.is_root() && ok == 1) {
+        try {
+            const double seconds = seconds_since(started);
+            if (interrupted) {
+                record_partial_run(partial, seconds, provenance);
+            } else {
+                observer.finishing();
+                finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout,
+                                       recorder->journal().tiles(), {provenance, seconds_before + seconds, true});
+            }
+        } catch (const std::exception& e) {
+            ok = 0;
+            failure = fmt::format("{} {} failed: {}", interrupted ? "recording the run in" : "finishing the result from",
+                                  partial.string(), e.what());
+        }
+    }
+    if (comm.broadcast(ok) == 0) {
+        comm.broadcast(failure);
+        throw RunError(failure);
+    }
+    return finish;
+}
+
+}  // namespace
+
 RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm, RunObserver& observer,
                        const StopRequested& stop)
 {
@@ -463,78 +663,18 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
 
     // The partial file and its journal: made by rank 0 (a new run) or read (a resume).
     const Grid grid(job);
-    StartedPartial started_partial;
-    std::int64_t failed = 0;
-    std::string failure;
-    if (comm.is_root()) {
-        try {
-            started_partial = start_partial(partial, plan.mode, job, grid, comm.size(), provenance);
-        } catch (const RunError& e) {
-            failed = 1;
-            failure = e.what();
-        }
-    }
-    if (comm.broadcast(failed) != 0) {
-        comm.broadcast(failure);
-        throw RunError(failure);
-    }
-    auto& [tile_shape, layout, journal, earlier_seconds] = started_partial;
-    comm.broadcast(tile_shape);
-    broadcast(comm, layout);
-    const Tiling tiling(grid.shape(), tile_shape);
+    StartedPartial start = start_everywhere(comm, partial, plan.mode, job, grid, provenance);
+    const PartialLayout& layout = start.layout;
+    const Tiling tiling(grid.shape(), start.tile_shape);
     PartialFile file(partial, comm, tiling, layout);
-
-    // The tiles to compute, on every rank; a resume first checks the tiles already done.
-    std::vector<std::uint64_t> done_tiles;
-    for (std::uint64_t t = 0; t < journal.done.size(); ++t) {
-        if (journal.done[t] != 0) done_tiles.push_back(t);
-    }
-    comm.broadcast(done_tiles);
-    if (plan.mode == PlanMode::resume) {
-        std::vector<std::uint64_t> sums, where;  // of the done tiles: rank 0 read them
-        if (comm.is_root()) {
-            for (const std::uint64_t t : done_tiles) {
-                sums.push_back(journal.checksums[t]);
-                if (layout.compressed) {
-                    const StoredChunk& c = journal.stored[t];
-                    where.insert(where.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
-                }
-            }
-        }
-        comm.broadcast(sums);
-        comm.broadcast(where);
-        std::vector<StoredChunk> stored(where.size() / 3);
-        for (std::size_t i = 0; i < stored.size(); ++i) stored[i] = {where[3 * i], where[3 * i + 1], where[3 * i + 2]};
-        if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums, stored); !bad.empty()) {
-            file.close();
-            throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
-                                         "checksum written with them; refusing to resume onto it: --overwrite to start "
-                                         "again, or --output to write elsewhere",
-                                         partial.string(), bad.size(), done_tiles.size(), bad.front()));
-        }
-    }
-    std::vector<std::uint64_t> pending;
-    {
-        std::uint64_t d = 0;
-        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-            if (d < done_tiles.size() && done_tiles[d] == t) {
-                ++d;
-            } else {
-                pending.push_back(t);
-            }
-        }
-    }
-    // Rank 0 records the tiles done, and writes the compressed ones (from the end of the
-    // file: whatever an interrupted run wrote past its last record stays unused).
-    std::optional<Journal> record;
-    std::optional<ChunkAppender> appender;
+    TilesLeft left = tiles_left(comm, file, partial, plan.mode, start.journal, layout, tiling);
+    std::optional<Recorder> recorder;
     if (comm.is_root()) {
-        RunStart start{plan.output, plan.note, comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(),
-                       done_tiles.size(), 0};
-        for (const std::uint64_t t : done_tiles) start.points_done += tiling.box(t).points();
-        observer.started(start);
-        record.emplace(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds));
-        if (layout.compressed) appender.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
+        RunStart run_start{plan.output, plan.note, comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(),
+                           left.done.size(), 0};
+        for (const std::uint64_t t : left.done) run_start.points_done += tiling.box(t).points();
+        observer.started(run_start);
+        recorder.emplace(file, partial, std::move(start.journal), job, layout, tiling, observer);
     }
 
     // Uncompressed tiles: each rank writes its own, in pieces of at least one alignment
@@ -547,91 +687,23 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     std::optional<TileWriter> writer;
     if (!layout.compressed) writer.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
     Work work(job, grid, tiling, layout, writer ? &*writer : nullptr, settings.kernel);
-    const auto recorded = [&](std::span<const AppendedTile> tiles) {
-        record->record(tiles);
-        std::uint64_t points = 0;
-        for (const AppendedTile& a : tiles) points += tiling.box(a.tile).points();
-        if (!tiles.empty()) observer.tiles_done(tiles.size(), points);
-    };
-    // The journal written, and, for compressed tiles, every tile written so far recorded
-    // first and then covered by the file's HDF5 end (PlacedChunks::cover): between two
-    // checkpoints the partial file is a consistent HDF5 file holding every tile it records.
-    // (The write in progress is waited for: tiles are recorded once written, and a tile
-    // written a moment ago would otherwise wait a whole report period for the next call.)
-    const auto checkpoint = [&] {
-        if (appender) recorded(appender->flush());
-        if (record->checkpoint(true) && appender) PlacedChunks::cover(partial);
-    };
     const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
-        if (appender) {
-            const TileBatch batch = TileBatch::unpack(payload);
-            const std::vector<TileReport> carried = batch.reports();
-            if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
-                    return a.tile == b.tile && a.checksum == b.checksum;
-                })) {
-                throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
-            }
-            appender->add(batch);
-            recorded(appender->written());
-        } else {
-            record->record(tiles);
-            std::uint64_t points = 0;
-            for (const TileReport& r : tiles) points += tiling.box(r.tile).points();
-            observer.tiles_done(tiles.size(), points);
-        }
-        if (record->due()) checkpoint();
+        recorder->done(tiles, payload);
     };
     ScheduleSettings schedule;
     // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
     // and the granule only groups tiles for the interleaved hand-out.
     schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
-    pending = handout_order(pending, schedule.granule, comm.size() >= settings.interleave_ranks);
+    const std::vector<std::uint64_t> pending =
+        handout_order(left.pending, schedule.granule, comm.size() >= settings.interleave_ranks);
     const auto compute_start = std::chrono::steady_clock::now();
     const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule);
     const auto compute_end = std::chrono::steady_clock::now();
     const double compute_seconds = comm.broadcast(std::chrono::duration<double>(compute_end - compute_start).count());
     if (comm.is_root()) observer.computed(compute_seconds);
 
-    // The last tiles written and recorded; the run's figures, in the partial file (a stop)
-    // or the result (complete), by rank 0 alone once every rank has closed the file.
-    std::int64_t ok = 1;
-    FinishReport finish;
-    if (comm.is_root()) {
-        try {
-            if (r.interrupted) {
-                checkpoint();
-            } else {
-                // The result's figures and index come next: the journal needs no cover.
-                if (appender) recorded(appender->flush());
-                record->checkpoint(true);
-            }
-        } catch (const std::exception& e) {
-            ok = 0;
-            failure = e.what();
-        }
-    }
-    file.close();
-    comm.barrier();
-    if (comm.is_root() && ok == 1) {
-        try {
-            const double seconds = seconds_since(started);
-            if (r.interrupted) {
-                record_partial_run(partial, seconds, provenance);
-            } else {
-                observer.finishing();
-                finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, record->tiles(),
-                                       {provenance, earlier_seconds + seconds, true});
-            }
-        } catch (const std::exception& e) {
-            ok = 0;
-            failure = fmt::format("{} {} failed: {}", r.interrupted ? "recording the run in" : "finishing the result from",
-                                  partial.string(), e.what());
-        }
-    }
-    if (comm.broadcast(ok) == 0) {
-        comm.broadcast(failure);
-        throw RunError(failure);
-    }
+    const FinishReport finish = close_run(comm, file, recorder, r.interrupted, partial, job, grid, tiling, layout,
+                                          provenance, plan, start.earlier_seconds, started, observer);
     if (!r.interrupted) {
         // From the last tile counted to the result under its name.
         summary.finish_seconds = comm.broadcast(comm.is_root() ? seconds_since(compute_end) : 0.0);
