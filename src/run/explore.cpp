@@ -405,6 +405,58 @@ fs::path output_path(const Job& job, const ExploreSettings& settings)
     return out;
 }
 
+Recorder::Recorder(PartialFile& file, const fs::path& partial, TileJournal journal, const Job& job,
+                   const PartialLayout& layout, const Tiling& tiling, RunObserver& observer)
+    : partial_(partial), tiling_(tiling), observer_(observer),
+      record_(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds))
+{
+    if (layout.compressed) appender_.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
+}
+
+void Recorder::done(std::span<const TileReport> tiles, std::span<const std::byte> payload)
+{
+    if (appender_) {
+        const TileBatch batch = TileBatch::unpack(payload);
+        const std::vector<TileReport> carried = batch.reports();
+        if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
+                return a.tile == b.tile && a.checksum == b.checksum;
+            })) {
+            throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
+        }
+        appender_->add(batch);
+        recorded(appender_->written());
+    } else {
+        record_.record(tiles);
+        std::uint64_t points = 0;
+        for (const TileReport& r : tiles) points += tiling_.box(r.tile).points();
+        observer_.tiles_done(tiles.size(), points);
+    }
+    if (record_.due()) checkpoint();
+}
+
+// Between two checkpoints the partial file is a consistent HDF5 file holding every tile it
+// records. (The write in progress is waited for: tiles are recorded once written, and a
+// tile written a moment ago would otherwise wait a whole report period for the next call.)
+void Recorder::checkpoint()
+{
+    if (appender_) recorded(appender_->flush());
+    if (record_.checkpoint(true) && appender_) PlacedChunks::cover(partial_);
+}
+
+void Recorder::last()
+{
+    if (appender_) recorded(appender_->flush());
+    record_.checkpoint(true);
+}
+
+void Recorder::recorded(std::span<const AppendedTile> tiles)
+{
+    record_.record(tiles);
+    std::uint64_t points = 0;
+    for (const AppendedTile& a : tiles) points += tiling_.box(a.tile).points();
+    if (!tiles.empty()) observer_.tiles_done(tiles.size(), points);
+}
+
 namespace {
 
 // decide(), which never throws: whatever goes wrong, every rank must hear the verdict.
@@ -519,78 +571,6 @@ TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& p
     }
     return left;
 }
-
-// Rank 0's record of the run: the tiles done, in the journal, and the compressed ones
-// written (from the end of the file: whatever an interrupted run wrote past its last record
-// stays unused).
-class Recorder {
-public:
-    Recorder(PartialFile& file, const fs::path& partial, TileJournal journal, const Job& job, const PartialLayout& layout,
-             const Tiling& tiling, RunObserver& observer)
-        : partial_(partial), tiling_(tiling), observer_(observer),
-          record_(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds))
-    {
-        if (layout.compressed) appender_.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
-    }
-
-    // TilesDone: the reports of finished tiles, with their compressed data when rank 0 writes them.
-    void done(std::span<const TileReport> tiles, std::span<const std::byte> payload)
-    {
-        if (appender_) {
-            const TileBatch batch = TileBatch::unpack(payload);
-            const std::vector<TileReport> carried = batch.reports();
-            if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
-                    return a.tile == b.tile && a.checksum == b.checksum;
-                })) {
-                throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
-            }
-            appender_->add(batch);
-            recorded(appender_->written());
-        } else {
-            record_.record(tiles);
-            std::uint64_t points = 0;
-            for (const TileReport& r : tiles) points += tiling_.box(r.tile).points();
-            observer_.tiles_done(tiles.size(), points);
-        }
-        if (record_.due()) checkpoint();
-    }
-
-    // The journal written, and, for compressed tiles, every tile written so far recorded
-    // first and then covered by the file's HDF5 end (PlacedChunks::cover): between two
-    // checkpoints the partial file is a consistent HDF5 file holding every tile it records.
-    // (The write in progress is waited for: tiles are recorded once written, and a tile
-    // written a moment ago would otherwise wait a whole report period for the next call.)
-    void checkpoint()
-    {
-        if (appender_) recorded(appender_->flush());
-        if (record_.checkpoint(true) && appender_) PlacedChunks::cover(partial_);
-    }
-
-    // The last tiles of a complete run: the result's figures and index come next, so the
-    // journal needs no cover.
-    void last()
-    {
-        if (appender_) recorded(appender_->flush());
-        record_.checkpoint(true);
-    }
-
-    const Journal& journal() const { return record_; }
-
-private:
-    void recorded(std::span<const AppendedTile> tiles)
-    {
-        record_.record(tiles);
-        std::uint64_t points = 0;
-        for (const AppendedTile& a : tiles) points += tiling_.box(a.tile).points();
-        if (!tiles.empty()) observer_.tiles_done(tiles.size(), points);
-    }
-
-    const fs::path& partial_;
-    const Tiling& tiling_;
-    RunObserver& observer_;
-    Journal record_;
-    std::optional<ChunkAppender> appender_;
-};
 
 // What rank 0 does with the partial file once the tiles are counted: an interrupted run's
 // seconds recorded in it, a complete run's result made from it. A failure on rank 0 is

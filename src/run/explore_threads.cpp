@@ -85,6 +85,33 @@ bool count_tiles(std::span<const std::uint64_t> pending, std::span<const std::un
     return computed.load() < pending.size();
 }
 
+// The tiles done and those left to compute, once the done ones are checked against the
+// checksums written with them.
+std::pair<std::vector<std::uint64_t>, std::vector<std::uint64_t>> tiles_left(PartialFile& file, const fs::path& partial,
+                                                                             const TileJournal& journal,
+                                                                             const PartialLayout& layout, const Tiling& tiling)
+{
+    std::vector<std::uint64_t> done_tiles, sums, pending;
+    std::vector<StoredChunk> stored;
+    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
+        if (journal.done[t] == 0) {
+            pending.push_back(t);
+            continue;
+        }
+        done_tiles.push_back(t);
+        sums.push_back(journal.checksums[t]);
+        if (layout.compressed) stored.push_back(journal.stored[t]);
+    }
+    if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums, stored); !bad.empty()) {
+        file.close();
+        throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
+                                     "written with them; refusing to resume onto it: overwrite to start again, or write "
+                                     "elsewhere",
+                                     partial.string(), bad.size(), done_tiles.size(), bad.front()));
+    }
+    return {std::move(done_tiles), std::move(pending)};
+}
+
 }  // namespace
 
 RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, unsigned threads, RunObserver& observer,
@@ -111,61 +138,21 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
         start_partial(partial, plan.mode, job, grid, static_cast<int>(threads), provenance);
     const Tiling tiling(grid.shape(), tile_shape);
     PartialFile file(partial, tiling, layout);
-    std::vector<std::uint64_t> done_tiles, sums, pending;
-    std::vector<StoredChunk> stored;
-    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-        if (journal.done[t] == 0) {
-            pending.push_back(t);
-            continue;
-        }
-        done_tiles.push_back(t);
-        sums.push_back(journal.checksums[t]);
-        if (layout.compressed) stored.push_back(journal.stored[t]);
-    }
-    if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums, stored); !bad.empty()) {
-        file.close();
-        throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
-                                     "written with them; refusing to resume onto it: overwrite to start again, or write "
-                                     "elsewhere",
-                                     partial.string(), bad.size(), done_tiles.size(), bad.front()));
-    }
+    const auto [done_tiles, pending] = tiles_left(file, partial, journal, layout, tiling);
     RunStart start{plan.output, plan.note, 1, job.points(), tiling.tiles(), tiling.box(0).points(), done_tiles.size(), 0};
     for (const std::uint64_t t : done_tiles) start.points_done += tiling.box(t).points();
     observer.started(start);
 
     // The writer side, as rank 0's: the journal, and one appender of compressed tiles (or,
     // uncompressed, a writer per thread at the tiles' own offsets).
-    Journal record(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds));
-    std::optional<ChunkAppender> appender;
-    if (layout.compressed) appender.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
+    Recorder recorder(file, partial, std::move(journal), job, layout, tiling, observer);
     std::vector<std::optional<TileWriter>> writers(threads);
     std::vector<std::unique_ptr<ExploreWork>> works;
     for (std::optional<TileWriter>& w : writers) {
         if (!layout.compressed) w.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
         works.push_back(make_explore_work(job, grid, tiling, layout, w ? &*w : nullptr, settings.kernel));
     }
-    const auto recorded = [&](std::span<const AppendedTile> tiles) {
-        record.record(tiles);
-        std::uint64_t points = 0;
-        for (const AppendedTile& a : tiles) points += tiling.box(a.tile).points();
-        if (!tiles.empty()) observer.tiles_done(tiles.size(), points);
-    };
-    const auto checkpoint = [&] {
-        if (appender) recorded(appender->flush());
-        if (record.checkpoint(true) && appender) PlacedChunks::cover(partial);
-    };
-    const auto on_done = [&](Flushed f) {
-        if (appender) {
-            appender->add(TileBatch::unpack(f.payload));
-            recorded(appender->written());
-        } else {
-            record.record(f.reports);
-            std::uint64_t points = 0;
-            for (const TileReport& r : f.reports) points += tiling.box(r.tile).points();
-            observer.tiles_done(f.reports.size(), points);
-        }
-        if (record.due()) checkpoint();
-    };
+    const auto on_done = [&](const Flushed& f) { recorder.done(f.reports, f.payload); };
     const std::uint64_t granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
     const auto compute_start = std::chrono::steady_clock::now();
     const bool interrupted = count_tiles(pending, works, granule, ScheduleSettings{}.report_seconds, on_done, stop);
@@ -177,10 +164,9 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     std::string step = "recording the last tiles in";
     try {
         if (interrupted) {
-            checkpoint();
+            recorder.checkpoint();
         } else {
-            if (appender) recorded(appender->flush());
-            record.checkpoint(true);
+            recorder.last();
         }
         file.close();
         const double seconds = seconds_since(started);
@@ -190,7 +176,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
         } else {
             step = "finishing the result from";
             observer.finishing();
-            finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, record.tiles(),
+            finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, recorder.journal().tiles(),
                                    {provenance, earlier_seconds + seconds, true});
         }
     } catch (const std::exception& e) {

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "core/kernels.hpp"
@@ -44,6 +46,35 @@ struct StartedPartial {
 };
 StartedPartial start_partial(const std::filesystem::path& partial, PlanMode mode, const Job& job, const Grid& grid, int ranks,
                              const Provenance& provenance);
+
+// The record of a run, kept by the one process that writes it (rank 0, or
+// run_explore_threads): the tiles done, in the journal, and the compressed ones written
+// (from the end of the file: whatever an interrupted run wrote past its last record stays
+// unused). Every argument must outlive it.
+class Recorder {
+public:
+    Recorder(PartialFile& file, const std::filesystem::path& partial, TileJournal journal, const Job& job,
+             const PartialLayout& layout, const Tiling& tiling, RunObserver& observer);
+
+    // The reports of finished tiles, with their compressed data when this process writes them.
+    void done(std::span<const TileReport> tiles, std::span<const std::byte> payload);
+    // The journal written, and, for compressed tiles, every tile written so far recorded
+    // first and then covered by the file's HDF5 end (PlacedChunks::cover).
+    void checkpoint();
+    // The last tiles of a complete run: the result's figures and index come next, so the
+    // journal needs no cover.
+    void last();
+    const Journal& journal() const { return record_; }
+
+private:
+    void recorded(std::span<const AppendedTile> tiles);
+
+    const std::filesystem::path& partial_;
+    const Tiling& tiling_;
+    RunObserver& observer_;
+    Journal record_;
+    std::optional<ChunkAppender> appender_;
+};
 
 // Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
 double peak_rss_mib();
