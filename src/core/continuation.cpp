@@ -463,6 +463,69 @@ struct Direction {
     bool closed = false;  // came back to the start
 };
 
+// Where the branch leaves the region or the parameter range on the step a -> b (node ia to
+// the next): the first such crossing.
+std::optional<Located> first_exit(const Context& c, const Node& a, const Node& b, double h, const std::vector<double>& va,
+                                  const std::vector<double>& vb, std::size_t ia)
+{
+    std::optional<Located> stop;
+    for (std::size_t j = 0; j < c.tests.size(); ++j) {
+        if (!terminal(c.tests[j].kind) || !(va[j] > 0.0) || vb[j] > 0.0) continue;
+        Position where = locate(c, j, a, h, va[j], b, vb[j]);
+        if (stop && stop->h <= where.h) continue;
+        const TestKind kind = c.tests[j].kind;
+        const bool bound = kind == TestKind::lower_bound || kind == TestKind::upper_bound;
+        Node n = std::move(where.node);
+        double bracket = where.bracket;
+        if (bound) {
+            const double value = kind == TestKind::upper_bound ? c.set.max : c.set.min;
+            if (auto exact = solve_at_parameter(c.sys, n.y, value, a.t)) {
+                n = std::move(*exact);
+                bracket = 0.0;
+            }
+        }
+        stop = Located{std::move(n), ia, where.h, bound ? Event::end : Event::boundary,
+                       bound ? bound_note(c.sys, kind == TestKind::upper_bound) : boundary_note(kind), bracket};
+        if (bracket > location_tolerance * (1.0 + h)) stop->note += unlocated_note;
+    }
+    return stop;
+}
+
+// Sign changes of the other tests at b (the node after d's last, a step h on, with test
+// values vb) since their last significant value; `last` (per test: that sign and its node)
+// updated.
+std::vector<Located> sign_changes(const Context& c, const Direction& d, const std::vector<std::vector<double>>& values,
+                                  std::vector<std::pair<int, std::size_t>>& last, const Node& b, double h,
+                                  const std::vector<double>& vb)
+{
+    const std::size_t ia = d.nodes.size() - 1;
+    const std::vector<double>& va = values.back();
+    std::vector<Located> found;
+    for (std::size_t j = 0; j < c.tests.size(); ++j) {
+        if (terminal(c.tests[j].kind)) continue;
+        const int sb = significant_sign(c.tests[j], vb[j]);
+        if (sb == 0) continue;
+        const auto [sa, since] = last[j];
+        last[j] = {sb, ia + 1};
+        if (sa == 0 || sa == sb) continue;
+        // The zero lies between node `since` and b; noise in between may hide which step
+        // holds it: take the last step whose raw values differ in sign.
+        std::size_t i = ia;
+        double fa = va[j];
+        while (i > since && (fa > 0.0) == (vb[j] > 0.0)) fa = values[--i][j];
+        const Node& from = d.nodes[i];
+        const Node& to = i == ia ? b : d.nodes[i + 1];
+        const double step_h = (i == ia ? h : d.arclength[i + 1] - d.arclength[i]);
+        const double f_to = i == ia ? vb[j] : values[i + 1][j];
+        Position where = locate(c, j, from, step_h, fa, to, f_to);
+        auto what = classify_event(c.tests[j].kind, where.node);
+        if (!what) continue;
+        if (where.bracket > location_tolerance * (1.0 + step_h)) what->second += unlocated_note;
+        found.push_back({std::move(where.node), i, where.h, what->first, std::move(what->second), where.bracket});
+    }
+    return found;
+}
+
 Direction trace(const Context& c, const Node& start)
 {
     Direction d;
@@ -498,52 +561,8 @@ Direction trace(const Context& c, const Node& start)
         const std::vector<double>& va = values.back();
         const std::size_t ia = d.nodes.size() - 1;
 
-        // Where the branch leaves the region or the parameter range: the first such crossing.
-        std::optional<Located> stop;
-        for (std::size_t j = 0; j < c.tests.size(); ++j) {
-            if (!terminal(c.tests[j].kind) || !(va[j] > 0.0) || vb[j] > 0.0) continue;
-            Position where = locate(c, j, a, h, va[j], *b, vb[j]);
-            if (stop && stop->h <= where.h) continue;
-            const TestKind kind = c.tests[j].kind;
-            const bool bound = kind == TestKind::lower_bound || kind == TestKind::upper_bound;
-            Node n = std::move(where.node);
-            double bracket = where.bracket;
-            if (bound) {
-                const double value = kind == TestKind::upper_bound ? c.set.max : c.set.min;
-                if (auto exact = solve_at_parameter(c.sys, n.y, value, a.t)) {
-                    n = std::move(*exact);
-                    bracket = 0.0;
-                }
-            }
-            stop = Located{std::move(n), ia, where.h, bound ? Event::end : Event::boundary,
-                           bound ? bound_note(c.sys, kind == TestKind::upper_bound) : boundary_note(kind), bracket};
-            if (bracket > location_tolerance * (1.0 + h)) stop->note += unlocated_note;
-        }
-
-        // Sign changes of the other tests since their last significant value.
-        std::vector<Located> found;
-        for (std::size_t j = 0; j < c.tests.size(); ++j) {
-            if (terminal(c.tests[j].kind)) continue;
-            const int sb = significant_sign(c.tests[j], vb[j]);
-            if (sb == 0) continue;
-            const auto [sa, since] = last[j];
-            last[j] = {sb, ia + 1};
-            if (sa == 0 || sa == sb) continue;
-            // The zero lies between node `since` and b; noise in between may hide which step
-            // holds it: take the last step whose raw values differ in sign.
-            std::size_t i = ia;
-            double fa = va[j];
-            while (i > since && (fa > 0.0) == (vb[j] > 0.0)) fa = values[--i][j];
-            const Node& from = d.nodes[i];
-            const Node& to = i == ia ? *b : d.nodes[i + 1];
-            const double step_h = (i == ia ? h : d.arclength[i + 1] - d.arclength[i]);
-            const double f_to = i == ia ? vb[j] : values[i + 1][j];
-            Position where = locate(c, j, from, step_h, fa, to, f_to);
-            auto what = classify_event(c.tests[j].kind, where.node);
-            if (!what) continue;
-            if (where.bracket > location_tolerance * (1.0 + step_h)) what->second += unlocated_note;
-            found.push_back({std::move(where.node), i, where.h, what->first, std::move(what->second), where.bracket});
-        }
+        const std::optional<Located> stop = first_exit(c, a, *b, h, va, vb, ia);
+        std::vector<Located> found = sign_changes(c, d, values, last, *b, h, vb);
         for (Located& e : found) {
             if (stop && e.after == stop->after && e.h >= stop->h) continue;
             d.events.push_back(std::move(e));
@@ -551,7 +570,7 @@ Direction trace(const Context& c, const Node& start)
         if (stop) {
             d.end = stop->event;
             d.end_note = stop->note;
-            d.events.push_back(std::move(*stop));
+            d.events.push_back(*stop);
             return d;
         }
 

@@ -112,6 +112,17 @@ std::pair<std::vector<std::uint64_t>, std::vector<std::uint64_t>> tiles_left(Par
     return {std::move(done_tiles), std::move(pending)};
 }
 
+// The works' tallies (ExploreWork::tallies), summed.
+std::vector<std::uint64_t> tallies_of(std::span<const std::unique_ptr<ExploreWork>> works)
+{
+    std::vector<std::uint64_t> totals(outcome_count + 2, 0);
+    for (const auto& w : works) {
+        const std::vector<std::uint64_t> t = w->tallies();
+        for (std::size_t k = 0; k < totals.size(); ++k) totals[k] += t[k];
+    }
+    return totals;
+}
+
 }  // namespace
 
 RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, unsigned threads, RunObserver& observer,
@@ -188,11 +199,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
         summary.result_bytes = finish.file_bytes;
         summary.sidecar_note = finish.sidecar_note;
     }
-    std::vector<std::uint64_t> totals(outcome_count + 2, 0);
-    for (const auto& w : works) {
-        const std::vector<std::uint64_t> t = w->tallies();
-        for (std::size_t k = 0; k < totals.size(); ++k) totals[k] += t[k];
-    }
+    const std::vector<std::uint64_t> totals = tallies_of(works);
     summary.points_this_run = totals[outcome_count + 1];
     summary.points_counted = totals[outcome_count];
     summary.outcomes.assign(totals.begin(), totals.begin() + outcome_count);

@@ -74,8 +74,7 @@ std::string Layer::json(std::size_t index) const
     return out;
 }
 
-bool Layer::fill(const View& v, RegionCounts& out, std::vector<std::uint8_t>& from_file,
-                 std::vector<std::uint8_t>& not_computed) const
+bool Layer::holds(const View& v, std::optional<std::uint64_t>& slice) const
 {
     const Model& m = job_.model;
     if (!(m.wall.e == v.model.wall.e && m.wall.alpha == v.model.wall.alpha && m.floor.e == v.model.floor.e &&
@@ -87,7 +86,7 @@ bool Layer::fill(const View& v, RegionCounts& out, std::vector<std::uint8_t>& fr
     const Coordinate& gf = job_.grid[static_cast<std::size_t>(v.plane.fixed)];
     if (!gx.is_range() || !gy.is_range()) return false;
     // The plane: the file's fixed value, or the slice of its third axis that holds v.fixed.
-    std::optional<std::uint64_t> slice;
+    slice.reset();
     if (gf.is_range()) {
         slice = cell_of(*gf.range, v.fixed);
         if (!slice) return false;
@@ -96,8 +95,16 @@ bool Layer::fill(const View& v, RegionCounts& out, std::vector<std::uint8_t>& fr
     }
     // Zoomed in beyond the file's samples: computed.
     const auto spacing = [](const Range& r) { return (r.max - r.min) / static_cast<double>(r.n); };
-    if (spacing(v.x) < spacing(*gx.range) || spacing(v.y) < spacing(*gy.range)) return false;
+    return !(spacing(v.x) < spacing(*gx.range) || spacing(v.y) < spacing(*gy.range));
+}
 
+bool Layer::fill(const View& v, RegionCounts& out, std::vector<std::uint8_t>& from_file,
+                 std::vector<std::uint8_t>& not_computed) const
+{
+    std::optional<std::uint64_t> slice;
+    if (!holds(v, slice)) return false;
+    const Coordinate& gx = job_.grid[static_cast<std::size_t>(v.plane.x)];
+    const Coordinate& gy = job_.grid[static_cast<std::size_t>(v.plane.y)];
     std::vector<std::optional<std::uint64_t>> ix(v.x.n), iy(v.y.n);
     std::uint64_t lo[2] = {UINT64_MAX, UINT64_MAX}, hi[2] = {0, 0};
     const auto cells = [&](const Range& view, const Range& file, std::vector<std::optional<std::uint64_t>>& idx, int a) {

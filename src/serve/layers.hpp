@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,11 @@ public:
               std::vector<std::uint8_t>& not_computed) const;
 
 private:
+    // The file has data for this view: the same model, the view's plane among its axes at
+    // no finer a spacing than its samples; `slice`, the sample of its third axis that holds
+    // the plane (none when that coordinate is fixed).
+    bool holds(const View& v, std::optional<std::uint64_t>& slice) const;
+
     ResultReader reader_;
     Job job_;
     std::vector<int> dims_;  // the coordinate (0 xi, 1 U, 2 W) of each dimension of the data
