@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "core/count.hpp"
 #include "core/report.hpp"
+#include "job/result_json.hpp"
 #include "options.hpp"
 
 namespace superball::cli {

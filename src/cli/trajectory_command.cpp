@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "core/report.hpp"
+#include "job/result_json.hpp"
 #include "core/trajectory.hpp"
 #include "options.hpp"
 

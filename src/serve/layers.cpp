@@ -4,7 +4,7 @@
 #include <optional>
 
 #include "core/input.hpp"
-#include "core/report.hpp"
+#include "job/result_json.hpp"
 
 namespace superball::serve {
 
@@ -26,10 +26,7 @@ std::optional<std::uint64_t> cell_of(const Range& r, double x)
     return static_cast<std::uint64_t>(at);
 }
 
-std::string range_json(const Range& r)
-{
-    return "{\"min\": " + format_double(r.min) + ", \"max\": " + format_double(r.max) + ", \"n\": " + std::to_string(r.n) + "}";
-}
+nlohmann::ordered_json range_json(const Range& r) { return {{"min", r.min}, {"max", r.max}, {"n", r.n}}; }
 
 }  // namespace
 
@@ -50,27 +47,26 @@ Layer::Layer(const std::filesystem::path& path) : reader_(path)
     if (info.kind == FileKind::partial) tiles_done_ = reader_.tiles_done();
 }
 
-std::string Layer::json(std::size_t index) const
+nlohmann::ordered_json Layer::json(std::size_t index) const
 {
     const ResultInfo& info = reader_.info();
-    std::string out = "{\"index\": " + std::to_string(index) + ", \"path\": " + quote(reader_.path().string()) +
-                      ", \"kind\": " + quote(info.kind == FileKind::result ? "result" : "partial");
-    out += ", \"tiles\": " + std::to_string(info.tiles) + ", \"tiles_done\": " + std::to_string(info.tiles_done);
-    out += ", \"grid\": {";
-    for (std::size_t k = 0; k < job_.grid.size(); ++k) {
-        const Coordinate& c = job_.grid[k];
-        out += (k ? ", " : "") + quote(c.name) + ": " + (c.is_range() ? range_json(*c.range) : format_double(*c.fixed));
-    }
-    out += "}, \"model\": " + model_json(job_.model);
-    out += ", \"max_bounces\": " + std::to_string(job_.max_bounces);
+    nlohmann::ordered_json out = {{"index", index},
+                                  {"path", reader_.path().string()},
+                                  {"kind", info.kind == FileKind::result ? "result" : "partial"},
+                                  {"tiles", info.tiles},
+                                  {"tiles_done", info.tiles_done}};
+    nlohmann::ordered_json& grid = out["grid"] = nlohmann::ordered_json::object();
+    for (const Coordinate& c : job_.grid) grid[c.name] = c.is_range() ? range_json(*c.range) : nlohmann::ordered_json(*c.fixed);
+    out["model"] = model_json(job_.model);
+    out["max_bounces"] = job_.max_bounces;
     // The first axis across and the last up (for a volume: xi and W, the slices of the
     // quickstart job), the third coordinate fixed (a volume's middle axis at its middle sample).
     const auto axis = [&](std::size_t d) { return std::string(axis_names[static_cast<std::size_t>(dims_[d])]); };
     const int fixed = 3 - dims_.front() - dims_.back();
     const Coordinate& f = job_.grid[static_cast<std::size_t>(fixed)];
     const double value = f.is_range() ? f.range->sample(f.range->n / 2) : *f.fixed;
-    out += ", \"view\": {\"x\": " + quote(axis(0)) + ", \"y\": " + quote(axis(dims_.size() - 1)) + ", \"fixed\": " +
-           quote(axis_names[static_cast<std::size_t>(fixed)]) + ", \"value\": " + format_double(value) + "}}";
+    out["view"] = {{"x", axis(0)}, {"y", axis(dims_.size() - 1)}, {"fixed", axis_names[static_cast<std::size_t>(fixed)]},
+                   {"value", value}};
     return out;
 }
 
@@ -174,11 +170,11 @@ Layers::Layers(const std::vector<std::filesystem::path>& paths)
     for (const auto& p : paths) layers_.push_back(std::make_unique<Layer>(p));
 }
 
-std::string Layers::json() const
+nlohmann::ordered_json Layers::json() const
 {
-    std::string out = "[";
-    for (std::size_t k = 0; k < layers_.size(); ++k) out += (k ? ", " : "") + layers_[k]->json(k);
-    return out + "]";
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (std::size_t k = 0; k < layers_.size(); ++k) out.push_back(layers_[k]->json(k));
+    return out;
 }
 
 bool Layers::fill(std::size_t index, const View& v, RegionCounts& out, std::vector<std::uint8_t>& from_file,

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,7 +30,7 @@ public:
     explicit Layer(const std::filesystem::path& path);
 
     // The file, its grid, model and progress, and the view that shows it, as JSON.
-    std::string json(std::size_t index) const;
+    nlohmann::ordered_json json(std::size_t index) const;
 
     // Sets the points of `out` (a view's counts) that the file holds at the view's
     // resolution, with from_file[k] = 1; not_computed[k] = 1 for the points of a partial
@@ -55,7 +56,7 @@ public:
     explicit Layers(const std::vector<std::filesystem::path>& paths);
 
     std::size_t size() const { return layers_.size(); }
-    std::string json() const;  // [layer, ...]
+    nlohmann::ordered_json json() const;  // [layer, ...]
     // Layer::fill of layer `index`, one at a time.
     bool fill(std::size_t index, const View& v, RegionCounts& out, std::vector<std::uint8_t>& from_file,
               std::vector<std::uint8_t>& not_computed) const;

