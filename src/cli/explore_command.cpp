@@ -9,9 +9,6 @@
 #include "commands.hpp"
 #include "core/count.hpp"
 #include "core/kernels.hpp"
-#include "io/hdf5.hpp"
-#include "io/layout.hpp"
-#include "io/result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
 #include "mpi/mpi.hpp"
@@ -69,12 +66,13 @@ void print_summary(const Job& job, const RunSummary& r, const KernelVariant& ker
         fmt::print(stderr, "stopped {}: the run is kept in {} (consistent, {} not written yet); run the same command "
                            "with --resume to finish it\n",
                    StopSignals::which() != 0 ? "by a signal" : "after --stop-after seconds",
-                   layout::partial_path(r.output).string(), r.output.string());
+                   r.partial.string(), r.output.string());
     }
 }
 
-// What --dry-run prints: the validated job, one `key: value` a line, for people and scripts.
-void print_plan(const Job& job, const fs::path& out, int ranks)
+// What --dry-run prints: the validated job and dry_run_explore's plan, one `key: value` a
+// line, for people and scripts.
+void print_plan(const Job& job, const DryRun& d, int ranks)
 {
     fmt::print("job: valid\ncoordinates: {}\n", name(job.coordinates));
     for (const Coordinate& p : job.parameters) {
@@ -92,25 +90,23 @@ void print_plan(const Job& job, const fs::path& out, int ranks)
     fmt::print("points: {}\nmax_bounces: {}\n", job.points(), job.max_bounces);
     if (job.refine != 0) fmt::print("refine: coarse stride {}\n", job.refine);
     if (Grid(job).on_boundary_plane()) fmt::print("boundary plane: xi = {} (limits from inside)\n", *job.grid[0].fixed);
-    const Tiling tiling = default_tiling(job, ranks);
-    fmt::print("tiles: {} of up to {} points for {} rank{}\n", tiling.tiles(), tiling.box(0).points(), ranks,
+    fmt::print("tiles: {} of up to {} points for {} rank{}\n", d.tiling.tiles(), d.tiling.box(0).points(), ranks,
                ranks == 1 ? "" : "s");
+    if (d.plan) {
+        const char* mode = d.plan->mode == PlanMode::fresh ? "new run" : d.plan->mode == PlanMode::resume ? "resume" : "complete";
+        fmt::print("plan: {}{}{}\n", mode, d.plan->note.empty() ? "" : ": ", d.plan->note);
+    } else {
+        fmt::print("plan: refused: {}\n", d.refusal);
+    }
     // For batch scripts deciding between a new run and --resume: the result, or the partial
     // file of an interrupted run.
-    std::error_code ec;
-    const fs::path partial = layout::partial_path(out);
-    const bool has_partial = fs::exists(partial, ec);
-    const bool exists = has_partial || fs::exists(out, ec);
-    fmt::print("output: {}\noutput exists: {}\n", out.string(), exists ? "yes" : "no");
-    if (!exists) return;
-    fmt::print("partial file: {}\n", has_partial ? partial.string() : "none");
-    try {
-        const ResultReader reader(has_partial ? partial : out);
-        const ResultInfo& info = reader.info();
-        fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n",
-                   info.kind == FileKind::result ? "yes" : "no", info.tiles_done, info.tiles,
-                   info.job_fingerprint == fingerprint(job) ? "yes" : "no");
-    } catch (const std::exception&) {
+    fmt::print("output: {}\noutput exists: {}\n", d.output.string(), d.exists ? "yes" : "no");
+    if (!d.exists) return;
+    fmt::print("partial file: {}\n", d.has_partial ? d.partial.string() : "none");
+    if (d.existing) {
+        fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n", d.existing->complete ? "yes" : "no",
+                   d.existing->tiles_done, d.existing->tiles, d.existing->same_job ? "yes" : "no");
+    } else {
         fmt::print("output complete: unreadable (not a superball result)\n");
     }
 }
@@ -122,14 +118,12 @@ int explore(const ExploreOptions& opt)
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
     const bool root = world.is_root();
-    h5::silence_errors();
     try {
         const KernelVariant& kernel = select_kernel(opt.kernel);
         const Job job = load_job(opt.job);
         const ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
-        const fs::path out = output_path(job, settings);
         if (opt.dry_run) {
-            if (root) print_plan(job, out, world.size());
+            if (root) print_plan(job, dry_run_explore(job, settings, world.size()), world.size());
             return 0;
         }
         TerminalProgress progress(stderr, opt.quiet);

@@ -50,13 +50,17 @@ bool is_hdf5(const std::filesystem::path& path)
     return false;
 }
 
+// Every file opened or created through here: HDF5's own printing of its error stack is off
+// (the errors thrown say what failed), whoever the caller.
 Id create_file(const std::filesystem::path& path, hid_t fapl)
 {
+    silence_errors();
     return file_id(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), "create " + path.string());
 }
 
 Id open_file(const std::filesystem::path& path, bool writable, hid_t fapl)
 {
+    silence_errors();
     return file_id(H5Fopen(path.c_str(), writable ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl), "open " + path.string());
 }
 

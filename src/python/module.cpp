@@ -23,7 +23,6 @@
 #include "core/kernels.hpp"
 #include "core/report.hpp"
 #include "core/trajectory.hpp"
-#include "io/hdf5.hpp"
 #include "io/layout.hpp"
 #include "io/result_reader.hpp"
 #include "job/job.hpp"
@@ -294,7 +293,6 @@ py::dict job_dict(const Job& job)
 py::dict explore(const std::string& text, const std::string& source, const std::string& output, bool overwrite, bool resume,
                  unsigned threads, const std::string& kernel, const std::string& command, bool progress)
 {
-    h5::silence_errors();
     const Job job = parse_job(text, source);
     ExploreSettings settings;
     settings.output = output;
@@ -342,7 +340,6 @@ py::dict explore(const std::string& text, const std::string& source, const std::
 // file (a run not finished) is refused. Returns what the file says about itself.
 py::dict validate(const std::string& path)
 {
-    h5::silence_errors();
     std::error_code ec;
     if (!std::filesystem::exists(path, ec) && std::filesystem::exists(layout::partial_path(path), ec)) {
         throw FormatError(path + " does not exist yet: its run is not finished (" + layout::partial_path(path).string() +

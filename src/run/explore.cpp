@@ -624,6 +624,31 @@ FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<R
 
 }  // namespace
 
+DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks)
+{
+    const fs::path out = output_path(job, settings);
+    DryRun d{std::nullopt, {}, out, layout::partial_path(out), default_tiling(job, ranks), false, false, std::nullopt};
+    const Decision decision = decide_or_refuse(settings, out, job);
+    if (decision.verdict == Verdict::refuse) {
+        d.refusal = decision.message;
+    } else {
+        d.plan = plan_of(decision, out);
+    }
+    std::error_code ec;
+    d.has_partial = fs::exists(d.partial, ec);
+    d.exists = d.has_partial || fs::exists(out, ec);
+    if (!d.exists) return d;
+    try {
+        const ResultReader reader(d.has_partial ? d.partial : out);
+        const ResultInfo& info = reader.info();
+        d.existing = DryRun::Existing{info.kind == FileKind::result, info.tiles_done, info.tiles,
+                                      info.job_fingerprint == fingerprint(job)};
+    } catch (const std::exception&) {
+        // Not a superball file, or damaged: existing stays empty.
+    }
+    return d;
+}
+
 RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm, RunObserver& observer,
                        const StopRequested& stop)
 {
@@ -633,6 +658,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const fs::path partial = layout::partial_path(plan.output);
     RunSummary summary;
     summary.output = plan.output;
+    summary.partial = partial;
     summary.ranks = comm.size();
     summary.outcomes.assign(outcome_count, 0);
     if (plan.mode == PlanMode::complete) {

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,6 +67,27 @@ ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const 
 // The same decision for a run in this process alone (run/explore_threads.hpp: no MPI).
 ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings);
 
+// What `superball explore --dry-run` shows: the run planned for `ranks` ranks, without
+// running it or touching a file. `plan`/`refusal`: plan_explore's decision; the rest, the
+// output as it stands, for batch scripts choosing between a new run and --resume.
+struct DryRun {
+    std::optional<ExplorePlan> plan;  // none: refused, for the reason in `refusal`
+    std::string refusal;
+    std::filesystem::path output;
+    std::filesystem::path partial;  // OUTPUT.partial
+    Tiling tiling;
+    bool exists = false;       // the output or its partial file
+    bool has_partial = false;
+    struct Existing {
+        bool complete = false;  // a result (else a partial file)
+        std::uint64_t tiles_done = 0;
+        std::uint64_t tiles = 0;
+        bool same_job = false;
+    };
+    std::optional<Existing> existing;  // when it exists and reads as a superball file
+};
+DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks);
+
 // The provenance of a run of `settings` starting now (job/provenance.hpp): settings.command
 // (else this process's command line), the time, `ranks` on `hosts` with `threads` counting
 // threads each, and the kernel.
@@ -73,6 +95,7 @@ Provenance run_provenance(const ExploreSettings& settings, int ranks, int hosts,
 
 struct RunSummary {
     std::filesystem::path output;
+    std::filesystem::path partial;   // where the run is kept until complete (OUTPUT.partial)
     bool complete = false;           // every tile done, the result closed complete
     bool interrupted = false;        // stopped on request (resumable)
     bool nothing_to_do = false;      // the output was already complete

@@ -135,6 +135,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     const fs::path partial = layout::partial_path(plan.output);
     RunSummary summary;
     summary.output = plan.output;
+    summary.partial = partial;
     summary.outcomes.assign(outcome_count, 0);
     if (plan.mode == PlanMode::complete) {
         observer.started({plan.output, plan.note, 1, job.points(), 0, 0, 0, 0});

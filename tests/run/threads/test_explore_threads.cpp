@@ -95,11 +95,13 @@ TEST(RunExploreThreads, StoppedRunResumesToTheSameResult)
     const TempDir dir{"superball-threads"};
     const Job job = job_of("tile_points = 16\ncheckpoint_seconds = 0.01");
     const fs::path out = dir / "stopped.h5";
-    // The calling thread asks after each of its tiles: stop after 20 of them.
+    // The calling thread asks before each of its tiles: stop after 20 of them. One thread:
+    // with two, a loaded machine let the other thread count every tile before the calling
+    // one had asked 20 times (the run then completed, not stopped).
     std::atomic<int> polls{0};
     const StopRequested stop = [&] { return ++polls > 20; };
     Tally first;
-    const RunSummary r = run_explore_threads(job, settings(out), 2, first, stop);
+    const RunSummary r = run_explore_threads(job, settings(out), 1, first, stop);
     EXPECT_TRUE(r.interrupted);
     EXPECT_FALSE(fs::exists(out));
     {
