@@ -4,6 +4,7 @@
 #include <string>
 
 #include "continuation_output.hpp"
+#include "job/result_json.hpp"
 
 namespace superball::cli {
 
@@ -72,7 +73,7 @@ std::string continuation_json(const ContinuationResult& result, const Continuati
     const Model& m = run.model;
     const ContinuationSettings& s = run.settings;
     nlohmann::ordered_json out;
-    out["model"] = {{"e_wall", m.wall.e}, {"alpha_wall", m.wall.alpha}, {"e_floor", m.floor.e}, {"alpha_floor", m.floor.alpha}};
+    out["model"] = model_json(m);
     out.update({{"parameter", name(run.parameter)}, {"min", s.min}, {"max", s.max}, {"ranks", ranks},
                 {"step", s.initial_step}, {"min_step", s.min_step}, {"max_step", s.max_step}, {"max_points", s.max_points}});
     if (run.start) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "every_rank.hpp"
 #include "continuation_output.hpp"
 #include "core/continuation.hpp"
 #include "mpi/mpi.hpp"
@@ -70,19 +71,14 @@ int run(const ContinueOptions& opt)
     const Provenance prov{process_command_line(), utc_now(), world.size(), mpi::host_count(world), 1, ""};
     ContinuationRun cont;
     ContinuationResult result;
-    try {
+    const int status = on_every_rank("continue", world, [&] {
         cont = resolve(opt);
         result = continue_branches(cont, world);
-    } catch (const InputError& e) {
-        // Every rank checks the same input and gets the same verdict: one message is enough.
-        if (world.is_root()) fmt::print(stderr, "superball continue: {}\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        // The other ranks would wait in a collective for ever: end them all.
-        fmt::print(stderr, "superball continue (rank {}): error: {}\n", world.rank(), e.what());
-        world.abort(1);
-    }
-    if (!world.is_root()) return 0;
+        return 0;
+    });
+    // The output after the ranks are done with each other: a file that cannot be written
+    // ends rank 0 alone (main's error path).
+    if (status != 0 || !world.is_root()) return status;
 
     write_output(opt.output, [&](std::FILE* f) {
         if (opt.format == "json") {

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "every_rank.hpp"
 #include "core/count.hpp"
 #include "core/kernels.hpp"
 #include "job/grid.hpp"
@@ -118,7 +119,7 @@ int explore(const ExploreOptions& opt)
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
     const bool root = world.is_root();
-    try {
+    return on_every_rank("explore", world, [&] {
         const KernelVariant& kernel = select_kernel(opt.kernel);
         const Job job = load_job(opt.job);
         const ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
@@ -136,19 +137,7 @@ int explore(const ExploreOptions& opt)
         const RunSummary r = run_explore(job, settings, world, progress, stop);
         if (root && !r.nothing_to_do) print_summary(job, r, kernel);
         return r.interrupted ? 1 : 0;
-    } catch (const InputError& e) {
-        // Every rank reads the same job and gets the same verdict: one message is enough.
-        if (root) fmt::print(stderr, "superball explore: {}\n", e.what());
-        return 2;
-    } catch (const RunError& e) {
-        // Every rank failed alike, in step: one message, and a clean exit.
-        if (root) fmt::print(stderr, "superball explore: error: {}\n", e.what());
-        return 1;
-    } catch (const std::exception& e) {
-        // Past the job's validation the ranks may no longer be in step: end them all.
-        fmt::print(stderr, "superball explore (rank {}): error: {}\n", world.rank(), e.what());
-        world.abort(1);
-    }
+    });
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "every_rank.hpp"
+#include "job/result_json.hpp"
 #include "core/dynamics.hpp"
 #include "mpi/mpi.hpp"
 #include "run/cycles.hpp"
@@ -73,8 +75,7 @@ void write_json(std::FILE* f, const std::vector<Cycle>& cycles, const Model& mod
 {
     using Json = nlohmann::ordered_json;
     Json out;
-    out["model"] = {{"e_wall", model.wall.e}, {"alpha_wall", model.wall.alpha}, {"e_floor", model.floor.e},
-                    {"alpha_floor", model.floor.alpha}};
+    out["model"] = model_json(model);
     out.update({{"max_period", opt.period}, {"starts", opt.starts}, {"seed", opt.seed}, {"corner_search", opt.corner},
                 {"ranks", ranks}, {"residual_tolerance", residual_tolerance}, {"marginal_tolerance", marginal_tolerance}});
     out["cycles"] = Json::array();
@@ -96,23 +97,16 @@ int run(const FixedPointOptions& opt)
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
     Model model;
-    try {
+    std::vector<Cycle> cycles;
+    const int status = on_every_rank("fixed-points", world, [&] {
         model = resolve_model(opt.model, flag_spelling);
         validate(opt);
-    } catch (const InputError& e) {
-        // Every rank checks the same flags and gets the same verdict: one message is enough.
-        if (world.is_root()) fmt::print(stderr, "superball fixed-points: {}\n", e.what());
-        return 2;
-    }
-    std::vector<Cycle> cycles;
-    try {
         cycles = find_cycles(model, {opt.period, opt.starts, opt.seed, opt.corner}, world);
-    } catch (const std::exception& e) {
-        // The other ranks would wait in the gather for ever: end them all.
-        fmt::print(stderr, "superball fixed-points (rank {}): error: {}\n", world.rank(), e.what());
-        world.abort(1);
-    }
-    if (!world.is_root()) return 0;
+        return 0;
+    });
+    // The output after the ranks are done with each other: a file that cannot be written
+    // ends rank 0 alone (main's error path).
+    if (status != 0 || !world.is_root()) return status;
 
     write_output(opt.output, [&](std::FILE* f) {
         if (opt.format == "json") {

@@ -1,5 +1,7 @@
 #include "result_json.hpp"
 
+#include "core/trajectory.hpp"
+
 namespace superball {
 
 nlohmann::ordered_json model_json(const Model& m)

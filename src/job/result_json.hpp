@@ -9,9 +9,11 @@
 
 #include "core/count.hpp"
 #include "core/input.hpp"
-#include "core/trajectory.hpp"
 
 namespace superball {
+
+// Not core/trajectory.hpp: its Event would meet core/continuation.hpp's in files using both.
+struct Trajectory;
 
 // {"e_wall": ..., "alpha_wall": ..., "e_floor": ..., "alpha_floor": ...}
 nlohmann::ordered_json model_json(const Model& m);
