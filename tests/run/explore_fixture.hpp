@@ -14,6 +14,8 @@
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
+#include "run/progress.hpp"
+#include "run/work_pool.hpp"
 
 namespace superball::test_support {
 
@@ -41,6 +43,29 @@ inline Data direct(const Job& job)
     count_each(starts.view(), ModelMatrices::of(job.model), job.max_bounces, d.counts, d.outcomes);
     return d;
 }
+
+// Counts the observer's calls (rank 0's, under MPI).
+class Tally final : public RunObserver {
+public:
+    void started(const RunStart& s) override
+    {
+        ++starts;
+        start = s;
+    }
+    void tiles_done(std::uint64_t t, std::uint64_t p) override
+    {
+        tiles += t;
+        points += p;
+    }
+    void computed(double) override { ++computes; }
+    void finishing() override { ++finishes; }
+
+    RunStart start;
+    int starts = 0, computes = 0, finishes = 0;
+    std::uint64_t tiles = 0, points = 0;
+};
+
+inline const StopRequested never = [] { return false; };
 
 inline Data read_result(const std::filesystem::path& path)
 {

@@ -65,28 +65,8 @@ using test_support::direct;
 using test_support::job_of;
 using test_support::read_result;
 
-// Counts rank 0's observer calls.
-class Tally final : public RunObserver {
-public:
-    void started(const RunStart& s) override
-    {
-        ++starts;
-        start = s;
-    }
-    void tiles_done(std::uint64_t t, std::uint64_t p) override
-    {
-        tiles += t;
-        points += p;
-    }
-    void computed(double) override { ++computes; }
-    void finishing() override { ++finishes; }
-
-    RunStart start;
-    int starts = 0, computes = 0, finishes = 0;
-    std::uint64_t tiles = 0, points = 0;
-};
-
-const StopRequested never = [] { return false; };
+using test_support::never;
+using test_support::Tally;
 
 // Settings for an output: the best kernel of this processor unless told otherwise (the
 // scalar one gives the same bits, tests/core/test_kernels.cpp).

@@ -34,19 +34,8 @@ using test_support::direct;
 using test_support::job_of;
 using test_support::read_result;
 
-class Tally final : public RunObserver {
-public:
-    void started(const RunStart& s) override { start = s; }
-    void tiles_done(std::uint64_t t, std::uint64_t p) override
-    {
-        tiles += t;
-        points += p;
-    }
-    RunStart start;
-    std::uint64_t tiles = 0, points = 0;
-};
-
-const StopRequested never = [] { return false; };
+using test_support::never;
+using test_support::Tally;
 
 ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrite = false)
 {
