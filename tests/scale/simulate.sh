@@ -18,7 +18,7 @@
 # are in OUT/logs/NAME.N.log.
 #
 #   tests/scale/simulate.sh [--ranks "64 256 1024 4096"] [--startup-seconds S] [--tile-points T]
-#                           [--ratio-boxes K] [--out DIR] [--no-build]
+#                           [--ratio-boxes K] [--sample-points P] [--out DIR] [--no-build]
 #                           [--latency-factor F] [--bandwidth-factor F] [--fs-bandwidth-factor F]
 #                           [--metadata-factor F] [--noise SIGMA] [--slow-nodes FRACTION:SPEED]
 #                           [--lose-node] [--requeue-seconds S]
@@ -40,6 +40,9 @@
 #
 # Default: every job of jobs/cluster, OUT = build/scale. --tile-points: run the jobs in tiles
 # of T points whatever they or the default say (the logs are then NAME.tpT.N.log).
+# --sample-points P: the low-resolution sample of step 1 at about P points instead of 2.2
+# million (4400000: twice as dense, the check that the prediction does not hang on the
+# sampling; the sample and logs are then NAME.spP).
 # --no-build: use the superball and scale_costs of build/release (or $SUPERBALL_BUILD_DIR)
 # as they are (the ctest smoke run).
 # The model, step by step:
@@ -78,6 +81,7 @@ out=$root/build/scale
 build=true
 tile_points=
 ratio_boxes=32
+sample_points=2200000
 latency_factor=1 bandwidth_factor=1 fs_bandwidth_factor=1 metadata_factor=1
 stress_args=()
 stress=
@@ -90,6 +94,7 @@ while (($# > 0)); do
     --startup-seconds) startup=$2; shift 2 ;;
     --tile-points) tile_points=$2; shift 2 ;;
     --ratio-boxes) ratio_boxes=$2; shift 2 ;;
+    --sample-points) sample_points=$2; shift 2 ;;
     --latency-factor) latency_factor=$2; stress+=.lat$2; shift 2 ;;
     --bandwidth-factor) bandwidth_factor=$2; stress+=.bw$2; shift 2 ;;
     --fs-bandwidth-factor) fs_bandwidth_factor=$2; stress+=.fsbw$2; shift 2 ;;
@@ -101,7 +106,7 @@ while (($# > 0)); do
     --out) out=$2; shift 2 ;;
     --no-build) build=false; shift ;;
     -h|--help) sed -n '2,70p' "$0"; exit 0 ;;
-    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --ratio-boxes, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --help)" >&2; exit 2 ;;
+    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --ratio-boxes, --sample-points, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --help)" >&2; exit 2 ;;
     *) jobs+=("$1"); shift ;;
   esac
 done
@@ -151,29 +156,36 @@ EOF
   else
     label=$name$stress
   fi
+  # Another sample size (--sample-points): a sample, and lines, of their own.
+  lowname=$name
+  if ((sample_points != 2200000)); then
+    lowname=$name.sp$sample_points
+    label=$label.sp$sample_points
+  fi
   "$superball" explore "$job" --dry-run >/dev/null
   # 1. The low-resolution sample, computed again only when the job changed (tile_points
   #    and output aside: lowres_job.py leaves them out).
-  /usr/bin/python3 tests/scale/lowres_job.py "$job" "$out/lowres/$name.next.toml" "$out/lowres/$name.h5"
-  sed -i "1s|.*|# Lower-resolution sample of $name for the scaling simulation (tests/scale/lowres_job.py).|" "$out/lowres/$name.next.toml"
-  if ! cmp -s "$out/lowres/$name.next.toml" "$out/lowres/$name.toml" || [[ ! -f $out/lowres/$name.seconds ]]; then
-    mv "$out/lowres/$name.next.toml" "$out/lowres/$name.toml"
-    echo "simulate: computing $out/lowres/$name.toml at -n 1 (3 runs; on a machine doing nothing else)" >&2
-    tests/scale/computed.sh "$superball" "$out/lowres/$name.toml" 3 >"$out/lowres/$name.seconds" ||
-      { rm -f "$out/lowres/$name.seconds"; echo "simulate: $out/lowres/$name.toml failed" >&2; exit 1; }
+  /usr/bin/python3 tests/scale/lowres_job.py "$job" "$out/lowres/$lowname.next.toml" "$out/lowres/$lowname.h5" \
+    --points "$sample_points"
+  sed -i "1s|.*|# Lower-resolution sample of $name for the scaling simulation (tests/scale/lowres_job.py).|" "$out/lowres/$lowname.next.toml"
+  if ! cmp -s "$out/lowres/$lowname.next.toml" "$out/lowres/$lowname.toml" || [[ ! -f $out/lowres/$lowname.seconds ]]; then
+    mv "$out/lowres/$lowname.next.toml" "$out/lowres/$lowname.toml"
+    echo "simulate: computing $out/lowres/$lowname.toml at -n 1 (3 runs; on a machine doing nothing else)" >&2
+    tests/scale/computed.sh "$superball" "$out/lowres/$lowname.toml" 3 >"$out/lowres/$lowname.seconds" ||
+      { rm -f "$out/lowres/$lowname.seconds"; echo "simulate: $out/lowres/$lowname.toml failed" >&2; exit 1; }
   else
-    rm "$out/lowres/$name.next.toml"
+    rm "$out/lowres/$lowname.next.toml"
   fi
   # The job's cost per wall bounce, from its sample.
-  tiles=$("$superball" explore "$out/lowres/$name.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
-  ns_per_iteration=$(/usr/bin/python3 tests/scale/sample_model.py "$out/lowres/$name.h5" \
-    "$(cat "$out/lowres/$name.seconds")" "$tiles" "$NS_PER_POINT" "$US_PER_TILE" "$NS_PER_ITERATION")
+  tiles=$("$superball" explore "$out/lowres/$lowname.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
+  ns_per_iteration=$(/usr/bin/python3 tests/scale/sample_model.py "$out/lowres/$lowname.h5" \
+    "$(cat "$out/lowres/$lowname.seconds")" "$tiles" "$NS_PER_POINT" "$US_PER_TILE" "$NS_PER_ITERATION")
   for n in $ranks; do
     costs=$out/costs/$label.$n.bin
     log=$out/logs/$label.$n.log
     # 2. Tile costs for this rank count's tiling.
-    "$scale_costs" "$job" "$n" "$out/lowres/$name.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs" >"$log"
-    echo "simulate: ns_per_iteration=$ns_per_iteration (from $out/lowres/$name.h5)" >>"$log"
+    "$scale_costs" "$job" "$n" "$out/lowres/$lowname.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs" >"$log"
+    echo "simulate: ns_per_iteration=$ns_per_iteration (from $out/lowres/$lowname.h5)" >>"$log"
     field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" "$log" | head -1; }
     granule=$(field granule) points=$(sed -n 's/.*tile_points=\([0-9]*\).*/\1/p' "$log" | head -1)
     if [[ $(field compression) == 0 ]]; then
@@ -218,7 +230,7 @@ EOF
       sim "$costs" --lose-node-at "$at" --lost-record "$out/costs/$label.$n.lost"
       lost=$(grep '^lost_node_at_s=' "$log" | tail -1)
       [[ -n $lost ]] || { echo "simulate: no lost-node result for $label at $n ranks; see $log" >&2; exit 1; }
-      "$scale_costs" "$job" "$n" "$out/lowres/$name.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs.resumed" \
+      "$scale_costs" "$job" "$n" "$out/lowres/$lowname.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs.resumed" \
         "$out/costs/$label.$n.lost" >>"$log"
       sim "$costs.resumed"
       rm -f "$costs.resumed" "$out/costs/$label.$n.lost"
