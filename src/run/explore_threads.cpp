@@ -175,11 +175,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     FinishReport finish;
     std::string step = "recording the last tiles in";
     try {
-        if (interrupted) {
-            recorder.checkpoint();
-        } else {
-            recorder.last();
-        }
+        interrupted ? recorder.checkpoint() : recorder.last();
         file.close();
         const double seconds = seconds_since(started);
         if (interrupted) {
