@@ -60,13 +60,7 @@ private:
     fs::path path_;
 };
 
-using test_support::Data;
-using test_support::direct;
-using test_support::job_of;
-using test_support::read_result;
-
-using test_support::never;
-using test_support::Tally;
+using namespace test_support;  // job_of, direct, read_result, Data, Tally, never (explore_fixture.hpp)
 
 // Settings for an output: the best kernel of this processor unless told otherwise (the
 // scalar one gives the same bits, tests/core/test_kernels.cpp).

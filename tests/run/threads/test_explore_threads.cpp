@@ -29,13 +29,7 @@ namespace fs = std::filesystem;
 
 using test_support::TempDir;
 
-using test_support::Data;
-using test_support::direct;
-using test_support::job_of;
-using test_support::read_result;
-
-using test_support::never;
-using test_support::Tally;
+using namespace test_support;  // job_of, direct, read_result, Data, Tally, never (explore_fixture.hpp)
 
 ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrite = false)
 {
