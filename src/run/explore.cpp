@@ -413,6 +413,14 @@ Recorder::Recorder(PartialFile& file, const fs::path& partial, TileJournal journ
     if (layout.compressed) appender_.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
 }
 
+template <class Tile>
+void Recorder::tell(std::span<const Tile> tiles)
+{
+    std::uint64_t points = 0;
+    for (const Tile& t : tiles) points += tiling_.box(t.tile).points();
+    if (!tiles.empty()) observer_.tiles_done(tiles.size(), points);
+}
+
 void Recorder::done(std::span<const TileReport> tiles, std::span<const std::byte> payload)
 {
     if (appender_) {
@@ -427,9 +435,7 @@ void Recorder::done(std::span<const TileReport> tiles, std::span<const std::byte
         recorded(appender_->written());
     } else {
         record_.record(tiles);
-        std::uint64_t points = 0;
-        for (const TileReport& r : tiles) points += tiling_.box(r.tile).points();
-        observer_.tiles_done(tiles.size(), points);
+        tell(tiles);
     }
     if (record_.due()) checkpoint();
 }
@@ -452,9 +458,7 @@ void Recorder::last()
 void Recorder::recorded(std::span<const AppendedTile> tiles)
 {
     record_.record(tiles);
-    std::uint64_t points = 0;
-    for (const AppendedTile& a : tiles) points += tiling_.box(a.tile).points();
-    if (!tiles.empty()) observer_.tiles_done(tiles.size(), points);
+    tell(tiles);
 }
 
 namespace {

@@ -68,6 +68,9 @@ public:
 
 private:
     void recorded(std::span<const AppendedTile> tiles);
+    // The observer told of tiles recorded (TileReport or AppendedTile), with their points.
+    template <class Tile>
+    void tell(std::span<const Tile> tiles);
 
     const std::filesystem::path& partial_;
     const Tiling& tiling_;
