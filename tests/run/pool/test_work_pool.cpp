@@ -304,14 +304,21 @@ TEST(Resume, OnlyThePendingTilesAreComputed)
     expect_every_tile_once(rec, pending);
 }
 
-// The tiles of `all` not in the record, in their order: what a resumed run is given.
-std::vector<std::uint64_t> left_over(std::span<const std::uint64_t> all, const Record& rec)
+// The run resumed after `first`: given the tiles of `all` it did not record, in their order,
+// on a machine like its own, it records each of them once and none of `first`'s, so every
+// tile is recorded once over the two runs.
+void expect_resume_completes(const Record& first, std::span<const std::uint64_t> all, FakeMachine::Options machine,
+                             const Cost& cost, const ScheduleSettings& settings)
 {
-    std::vector<std::uint64_t> left;
+    std::vector<std::uint64_t> rest;
     for (const std::uint64_t t : all) {
-        if (!rec.recorded.contains(t)) left.push_back(t);
+        if (!first.recorded.contains(t)) rest.push_back(t);
     }
-    return left;
+    FakeMachine second(machine);
+    const Record b = run(second, machine.ranks, rest, cost, settings);
+    expect_every_tile_once(b, rest);
+    for (const auto& [tile, rank] : b.recorded) EXPECT_FALSE(first.recorded.contains(tile)) << "tile " << tile;
+    EXPECT_EQ(first.recorded.size() + b.recorded.size(), all.size()) << "node_ranks " << machine.node_ranks;
 }
 
 // A stop on one rank (a signal) ends every rank soon; the tiles recorded are a part of those
@@ -338,12 +345,7 @@ TEST(Resume, StopThenResumeRecordsEveryTileOnce)
         for (const auto& v : a.computed) computed += v.size();
         EXPECT_EQ(computed, a.recorded.size());
 
-        const std::vector<std::uint64_t> rest = left_over(all, a);
-        FakeMachine second({.ranks = ranks, .node_ranks = node_ranks});
-        const Record b = run(second, ranks, rest, cost, s);
-        expect_every_tile_once(b, rest);
-        for (const auto& [tile, rank] : b.recorded) EXPECT_FALSE(a.recorded.contains(tile)) << "tile " << tile;
-        EXPECT_EQ(a.recorded.size() + b.recorded.size(), all.size()) << "node_ranks " << node_ranks;
+        expect_resume_completes(a, all, {.ranks = ranks, .node_ranks = node_ranks}, cost, s);
     }
 }
 
@@ -382,11 +384,7 @@ TEST(LostRank, OnlyTilesNeverRecordedAreComputedAgain)
         EXPECT_LT(a.recorded.size(), computed) << "nothing was in flight: the test lost nothing";
         EXPECT_GT(a.recorded.size(), 0u);
 
-        const std::vector<std::uint64_t> rest = left_over(all, a);
-        FakeMachine second({.ranks = ranks, .node_ranks = node_ranks});
-        const Record b = run(second, ranks, rest, cost, s);
-        expect_every_tile_once(b, rest);
-        EXPECT_EQ(a.recorded.size() + b.recorded.size(), all.size());
+        expect_resume_completes(a, all, {.ranks = ranks, .node_ranks = node_ranks}, cost, s);
     }
 }
 
