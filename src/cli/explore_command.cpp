@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include "commands.hpp"
@@ -30,6 +31,8 @@ struct ExploreOptions {
     bool overwrite = false;
     bool quiet = false;
     bool dry_run = false;
+    bool stats = false;
+    int node_ranks = 0;  // 0: the ranks sharing memory form a node
     double stop_after = -1;  // seconds of computing, then a clean stop; < 0: none
     std::string kernel;  // empty: $SUPERBALL_KERNEL, else the best variant
 };
@@ -69,6 +72,17 @@ void print_summary(const Job& job, const RunSummary& r, const KernelVariant& ker
                    StopSignals::which() != 0 ? "by a signal" : "after --stop-after seconds",
                    r.partial.string(), r.output.string());
     }
+}
+
+// What --stats prints: one line of key=value, the names tests/scale/sim_run gives the same
+// figures (tests/scale/validate.sh --oversubscribed reads both).
+void print_schedule(const ScheduleFigures& s)
+{
+    fmt::print(stderr,
+               "schedule: tiles={} computing_ranks={} two_level={} tiles_min={} tiles_max={} root_blocks={} root_messages={} "
+               "root_requests={} root_asked_back={} max_leader_messages={} given_back={}\n",
+               s.tiles, s.computing_ranks, s.two_level ? 1 : 0, s.tiles_min, s.tiles_max, s.root_blocks, s.root_messages,
+               s.root_requests, s.root_asked_back, s.max_leader_messages, s.given_back);
 }
 
 // What --dry-run prints: the validated job and dry_run_explore's plan, one `key: value` a
@@ -122,7 +136,8 @@ int explore(const ExploreOptions& opt)
     return on_every_rank("explore", world, [&] {
         const KernelVariant& kernel = select_kernel(opt.kernel);
         const Job job = load_job(opt.job);
-        const ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
+        ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
+        settings.node_ranks = opt.node_ranks;
         if (opt.dry_run) {
             if (root) print_plan(job, dry_run_explore(job, settings, world.size()), world.size());
             return 0;
@@ -136,6 +151,7 @@ int explore(const ExploreOptions& opt)
         };
         const RunSummary r = run_explore(job, settings, world, progress, stop);
         if (root && !r.nothing_to_do) print_summary(job, r, kernel);
+        if (root && !r.nothing_to_do && opt.stats) print_schedule(r.schedule);
         return r.interrupted ? 1 : 0;
     });
 }
@@ -170,6 +186,13 @@ Runner add_explore_command(CLI::App& app)
                     "counting kernel, identical results: simd (the widest variant this processor runs, here " +
                         describe(best_kernel()) + "), scalar, or a variant of this build (" + variants +
                         "); default: $SUPERBALL_KERNEL, else simd");
+    sub->add_flag("--stats", opt->stats,
+                  "after the run, print how the schedule went: tiles per rank (fewest, most), blocks rank 0 handed "
+                  "out, messages it received, tiles given back (the figures tests/scale/simulate.sh predicts)");
+    sub->add_option("--node-ranks", opt->node_ranks,
+                    "schedule as if every N consecutive ranks were a node (default: the ranks sharing memory): "
+                    "the cluster's two-level schedule on one machine, for tests")
+        ->check(CLI::Range(1, std::numeric_limits<int>::max()));
     sub->add_flag("--dry-run", opt->dry_run, "check the job and print the plan (grid, tiles, output) without running");
     return [opt] { return explore(*opt); };
 }

@@ -626,6 +626,33 @@ FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<R
     return finish;
 }
 
+// Collective: every rank's ScheduleStats reduced to the run's figures (rank 0's own where
+// they are a server's). Four small reductions at the end of a run.
+ScheduleFigures schedule_figures(const mpi::Comm& comm, const ScheduleStats& mine)
+{
+    const bool root = comm.is_root();
+    const std::vector<std::uint64_t> sums =
+        comm.sum({mine.computed ? 1u : 0u, mine.given_back, root ? mine.handed_out.size() : 0u, root ? mine.messages_in : 0u,
+                  root ? mine.requests_in : 0u, root ? mine.asked_back : 0u, root && mine.two_level ? 1u : 0u, mine.tiles});
+    // Maxima as doubles (exact below 2^53): the most tiles, minus the fewest, the leaders' messages.
+    const double most = comm.max(mine.computed ? static_cast<double>(mine.tiles) : 0.0);
+    const double fewest = -comm.max(mine.computed ? -static_cast<double>(mine.tiles) : -most);
+    const double leader_messages = comm.max(root ? 0.0 : static_cast<double>(mine.messages_in));
+    ScheduleFigures f;
+    f.computing_ranks = static_cast<int>(sums[0]);
+    f.given_back = sums[1];
+    f.root_blocks = sums[2];
+    f.root_messages = sums[3];
+    f.root_requests = sums[4];
+    f.root_asked_back = sums[5];
+    f.two_level = sums[6] != 0;
+    f.tiles = sums[7];
+    f.tiles_max = static_cast<std::uint64_t>(most);
+    f.tiles_min = static_cast<std::uint64_t>(fewest);
+    f.max_leader_messages = static_cast<std::uint64_t>(leader_messages);
+    return f;
+}
+
 }  // namespace
 
 DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks)
@@ -701,6 +728,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
         recorder->done(tiles, payload);
     };
     ScheduleSettings schedule;
+    schedule.node_ranks = settings.node_ranks;
     // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
     // and the granule only groups tiles for the interleaved hand-out.
     schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
@@ -731,6 +759,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     summary.outcomes = std::move(totals);
     summary.compute_seconds = compute_seconds;
     summary.peak_rss_mib = comm.max(peak_rss_mib());
+    summary.schedule = schedule_figures(comm, r.stats);
     summary.interrupted = r.interrupted;
     summary.complete = !r.interrupted;
     return summary;

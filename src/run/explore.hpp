@@ -42,6 +42,10 @@ struct ExploreSettings {
     // For the result's history (job/provenance.hpp): the command or call that ran the job;
     // empty: this process's command line.
     std::string command{};
+    // The schedule's nodes (ScheduleSettings::node_ranks): 0, the ranks that share memory;
+    // n > 0, groups of n consecutive ranks (the two-level schedule on one machine, as
+    // tests/scale/validate.sh --oversubscribed runs it beside its simulation).
+    int node_ranks = 0;
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]
@@ -93,6 +97,22 @@ DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int rank
 // threads each, and the kernel.
 Provenance run_provenance(const ExploreSettings& settings, int ranks, int hosts, int threads);
 
+// How the schedule went, over every rank (the figures tests/scale/sim_run prints under the
+// same names, which tests/scale/validate.sh --oversubscribed compares): `explore --stats`.
+struct ScheduleFigures {
+    int computing_ranks = 0;         // ranks that counted tiles (rank 0 only serves from 64 ranks)
+    bool two_level = false;          // node leaders served their nodes
+    std::uint64_t tiles = 0;         // tiles counted, every rank
+    std::uint64_t tiles_min = 0;     // fewest tiles a computing rank counted
+    std::uint64_t tiles_max = 0;     // most
+    std::uint64_t root_blocks = 0;   // blocks rank 0 took from its pool
+    std::uint64_t root_messages = 0; // messages rank 0 received
+    std::uint64_t root_requests = 0; // of which requests for a block
+    std::uint64_t root_asked_back = 0;     // requests for tiles back rank 0 sent
+    std::uint64_t max_leader_messages = 0; // most messages another rank (a node leader) received
+    std::uint64_t given_back = 0;    // tiles given back, every rank
+};
+
 struct RunSummary {
     std::filesystem::path output;
     std::filesystem::path partial;   // where the run is kept until complete (OUTPUT.partial)
@@ -109,6 +129,7 @@ struct RunSummary {
     std::string sidecar_note;             // "sidecar: PATH", or why the result has none
     double peak_rss_mib = 0;              // largest over the ranks
     int ranks = 1;
+    ScheduleFigures schedule;             // this run's
 };
 
 // Collective over `comm`: plans (plan_explore), runs and finishes the job. Returns on

@@ -416,6 +416,8 @@ BAD_INPUT = [
     ("explore misspelt flag", ["explore", "job.toml", "--kernl", "simd"], "did you mean --kernel?"),
     ("explore resume and overwrite", ["explore", "job.toml", "--resume", "--overwrite"], "--resume"),
     ("explore output without a value", ["explore", "job.toml", "-o"], "--output"),
+    ("explore nodes of no rank", ["explore", "job.toml", "--node-ranks", "0"], "--node-ranks"),
+    ("explore nodes of text", ["explore", "job.toml", "--node-ranks", "many"], "--node-ranks"),
     ("explore missing job file", ["explore", "/nonexistent/job.toml"], "/nonexistent/job.toml"),
     # info and analyse
     ("info without a file", ["info"], "file"),

@@ -120,6 +120,15 @@ struct Options {
     // Rank 0 copying payloads (TileBatch::unpack, ChunkAppender::add: two copies a byte), GB/s
     // of payload: calibrate.sh measures it (COPY_GBPS), simulate.sh passes it.
     double copy_gbps = 10;
+    // The real program's write calls (strace of `superball explore` at -n 1, 2026-11-27: a
+    // 4-tile and a 65536-tile job): creating the partial file, 16 (HDF5's objects, the
+    // journal); the finish, 36 of 20.6 KB besides the index and the sidecar (the undo log's
+    // header and a copy of every HDF5 metadata write before it, the attributes, the
+    // superblock) and one for about 800 tiles of the index (HDF5's fixed-array pages). Counted as calls only: their latency is
+    // charged per MiB (client_write), as Lustre's client gathers small writes into RPCs.
+    double create_writes = 16;
+    double finish_writes = 36;
+    double index_tiles_per_write = 800;
     // From mpirun starting to the job parsed on every rank: MPI_Init at this many ranks.
     // An assumption (0.02 s here at 2 ranks with pml ob1; launches of thousands of ranks
     // over UCX and PMIx take seconds), stated in the output.
@@ -238,11 +247,14 @@ public:
     // one per MiB, the RPCs Lustre makes of a burst of small writes into the client's cache,
     // as HDF5's index pages at the finish): the data cross rank 0's client and the file
     // system at once.
-    void client_write(double bytes, double ops = 1)
+    // `calls`: the program's write calls it stands for (the count validate.sh compares).
+    void client_write(double bytes, double ops = 1, double calls = 1)
     {
         if (!on_ || bytes <= 0) return;
         if (ops <= 0) ops = std::ceil(bytes / (1 << 20));
         operations += static_cast<std::uint64_t>(ops);
+        write_calls += static_cast<std::uint64_t>(calls);
+        bytes_written += bytes;
         simgrid::s4u::this_actor::sleep_for(latency_ * ops);
         const auto n = static_cast<sg_size_t>(std::ceil(bytes));
         const simgrid::s4u::IoPtr a = disk_->write_async(n);
@@ -251,12 +263,21 @@ public:
         b->wait();
     }
     std::uint64_t operations = 0;
+    // The program's write calls as the model makes them (one a client_write or write) and
+    // their bytes: what tests/scale/validate.sh --oversubscribed compares with strace's count
+    // of the real run's.
+    std::uint64_t write_calls = 0;
+    double bytes_written = 0;
 
 private:
     void io(double bytes, bool write)
     {
         if (!on_ || bytes <= 0) return;
         ++operations;
+        if (write) {
+            ++write_calls;
+            bytes_written += bytes;
+        }
         simgrid::s4u::this_actor::sleep_for(latency_);
         const auto n = static_cast<sg_size_t>(std::ceil(bytes));
         if (write) disk_->write(n);
@@ -580,14 +601,16 @@ int run(int argc, char** argv)
     std::size_t recorded = 0;
 
     // The start (run/explore.cpp, io/partial_file.cpp create_partial): rank 0 creates the
-    // partial file (create, the HDF5 objects and the journal's datasets, 33 bytes a tile
-    // compressed, 9 uncompressed, a flush), every rank then opens it (POSIX); the other
-    // ranks wait for its layout.
-    const double journal_bytes_per_tile = o.compressed ? 33.0 : 9.0;
+    // partial file (create, the HDF5 objects and the journal's datasets, a flush: compressed,
+    // 14 KB and 35 bytes a tile in 16 write calls, measured as Options::create_writes was; 9
+    // bytes a tile uncompressed), every rank then opens it (POSIX); the other ranks wait for
+    // its layout.
+    const double journal_bytes_per_tile = o.compressed ? 35.0 : 9.0;
     const double t0 = MPI_Wtime();
     if (rank == 0) {
         fs.metadata();
-        fs.client_write(journal_bytes_per_tile * tiles + 65536, 0);
+        const double bytes = journal_bytes_per_tile * tiles + 14336;
+        fs.client_write(bytes, 0, o.create_writes);
         fs.metadata();
     }
     world.barrier();
@@ -725,12 +748,14 @@ int run(int argc, char** argv)
     if (rank == 0 && o.io) {
         fs.metadata();           // the undo log
         fs.metadata();           // the HDF5 open
-        fs.client_write(512);    // the superblock read and logged
+        // The superblock read and logged, the attributes, /progress unlinked, every write
+        // logged to the undo log first.
+        fs.client_write(20600, 2, o.finish_writes);
         if (o.compressed) {
             smpi_execute(o.index_us_per_tile * 1e-6 * tiles);
-            fs.client_write(30.0 * tiles, 0);
+            const double calls = std::ceil(tiles / o.index_tiles_per_write);
+            fs.client_write(30.0 * tiles, 0, calls);
         }
-        fs.client_write(4096);   // attributes, /progress unlinked, the superblock
         fs.metadata();           // close
         fs.metadata();           // rename
         fs.metadata();           // the undo log unlinked
@@ -756,18 +781,23 @@ int run(int argc, char** argv)
         return v;
     };
     const double last = work.last_end;
-    const std::vector<double> mins = reduce({r.stats.computed ? last : 1e300}, MPI_MIN);
+    const double tiles_here = static_cast<double>(r.stats.tiles);
+    const std::vector<double> mins = reduce({r.stats.computed ? last : 1e300, r.stats.computed ? tiles_here : 1e300}, MPI_MIN);
     const std::vector<double> maxs =
-        reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start},
+        reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start,
+                r.stats.computed ? tiles_here : 0.0},
                MPI_MAX);
     const std::vector<double> sums = reduce({static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
-                                             r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes},
+                                             r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes,
+                                             r.stats.computed ? 1.0 : 0.0, static_cast<double>(fs.write_calls), fs.bytes_written},
                                             MPI_SUM);
     if (rank == 0) {
         double total = 0;
         for (const std::uint64_t t : costs.pending()) total += costs.cost(t);  // (every tile, unless resumed)
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
-        const double ops = sums[0], given_back = sums[1], idle = sums[2], payload = sums[3];
+        const double ops = sums[0], given_back = sums[1], idle = sums[2], payload = sums[3], computing = sums[4],
+                     write_calls = sums[5], bytes_written = sums[6];
+        const double tiles_min = mins[1], tiles_max = maxs[3];
         // From mpirun starting (the stated start-up) to the result renamed; and the compute
         // phase, from the first tile handed out to the last done, as explore reports it.
         const double end_to_end = o.startup_seconds + (end - t0);
@@ -777,14 +807,16 @@ int run(int argc, char** argv)
                     "root_messages=%llu max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f "
                     "root_asked_back=%llu idle_s_per_rank=%.6g reported=%llu compressed=%d payload_bytes=%.6g "
                     "written_by_root=%.6g root_writes=%.0f writer_busy_s=%.6g writer_backlog_bytes=%.6g root_held_back_s=%.6g "
-                    "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g checkpoint_s=%.6g\n",
+                    "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g checkpoint_s=%.6g computing_ranks=%.0f tiles_min=%.0f "
+                    "tiles_max=%.0f write_calls=%.0f bytes_written=%.0f\n",
                     ranks, ideal / (scheduled - start), ideal / end_to_end, end_to_end, ideal, total, schedule_s,
                     o.startup_seconds, start - t0, end - finish_start, end - scheduled, last_busy - first_idle,
                     static_cast<unsigned long long>(costs.tiles()), static_cast<unsigned long long>(r.stats.requests_in),
                     static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(), ops,
                     r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back), idle / ranks,
                     static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writes, writer_busy,
-                    backlog, held_back, peak_ingress, copy_s, checkpoint_s);
+                    backlog, held_back, peak_ingress, copy_s, checkpoint_s, computing, tiles_min, tiles_max, write_calls,
+                    bytes_written);
         std::fflush(stdout);
     }
     return 0;

@@ -14,13 +14,34 @@
 # sharing of the cores).
 #
 #   tests/scale/validate.sh [REPS]
+#
+# --oversubscribed "16 32 64": the paths of a cluster run instead (rank 0 serving only, the
+# interleaved hand-out, node leaders: pseudo-nodes of 16 ranks, --node-ranks), on the
+# small corner-zoom copy, real and simulated at each of those rank counts. Times are not
+# compared (64 ranks share 2 cores), the counts are, one line each:
+#
+#   ranks=N quantity=Q real=R simulated=S check=exact|10% agreement=yes|NO (E)
+#
+# exact where they do not depend on timing (tiles, ranks counting, two levels), within
+# 10 % where they do (blocks rank 0 handed out, its requests and messages, the leaders'
+# messages, tiles per rank, the write calls to the result's files and their bytes: the
+# real run's counted by strace, tests/scale/write_calls.sh); the real figure is the median
+# of REPS runs. Exits 1 when one disagrees.
+#
+#   tests/scale/validate.sh --oversubscribed "16 32 64" [REPS]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 cd "$root"
+oversubscribed=
+if [[ ${1:-} == --oversubscribed ]]; then
+  oversubscribed=${2:?--oversubscribed needs rank counts, e.g. \"16 32 64\"}
+  shift 2
+fi
 reps=${1:-3}
 .ci/install-deps --scale
+[[ -z $oversubscribed ]] || .ci/install-deps --bench  # strace
 cmake --preset release >/dev/null
-cmake --build build/release -j"$(nproc)" --target superball scale_costs codec_speed >/dev/null
+cmake --build build/release -j"$(nproc)" --target superball scale_costs codec_speed core_wait >/dev/null
 if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 superball=$root/build/release/src/superball
 scale_costs=$root/build/release/tests/scale/scale_costs
@@ -59,6 +80,8 @@ output = "$out/trivial.h5"
 tile_points = 1024
 EOF
 cases=("jobs/full/volume.toml:1 2" "$out/zoom.toml:1 2 4" "$out/trivial.toml:2 4 8")
+[[ -n $oversubscribed ]] && cases=("$out/zoom.toml:$oversubscribed")
+node_ranks=16
 
 computed() {  # compute-phase seconds of real runs, the median of REPS: JOB RANKS
   tests/scale/computed.sh "$superball" "$1" "$reps" "$2" "$out/real.h5"
@@ -88,6 +111,45 @@ with h5py.File(sys.argv[1]) as f:
   rm -f "$out/$1.$3.bin"
 }
 
+# The real runs' counts (medians of REPS runs) against the simulation's, one
+# line each: NAME JOB RANKS NS_PER_ITERATION.
+compare_counts() {
+  local name=$1 job=$2 n=$3 ns=$4 r line granule codec ratio writes wait_s
+  # The schedule's counts from REPS plain runs; the write calls from one more under strace
+  # (which stops the process at every write: no timing of it is kept).
+  : >"$out/$name.$n.real"
+  for ((r = 0; r < reps; r++)); do
+    mpirun -n "$n" --oversubscribe "$superball" explore "$job" -o "$out/$name.real.h5" --overwrite -q --stats \
+      --node-ranks "$node_ranks" 2>&1 | sed -n 's/^schedule: //p' >>"$out/$name.$n.real"
+  done
+  writes=$(tests/scale/write_calls.sh "$out/$name.real" -- mpirun -n "$n" --oversubscribe "$superball" explore "$job" \
+    -o "$out/$name.real.h5" --overwrite -q --node-ranks "$node_ranks" 2>"$out/$name.$n.strace.log")
+  sed -i "s/\$/ $writes/" "$out/$name.$n.real"
+  line=$("$scale_costs" "$job" "$n" "$out/$name.low.h5" "$NS_PER_POINT" "$ns" "$US_PER_TILE" "$out/$name.$n.bin")
+  granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' <<<"$line")
+  codec=$("$root/build/release/tests/scale/codec_speed" "$out/$name.real.h5" "$(sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$line")")
+  ratio=$(/usr/bin/python3 -c '
+import sys, h5py
+with h5py.File(sys.argv[1]) as f:
+    d = [f["wall_bounces"], f["outcome"]]
+    print(sum(x.size * x.dtype.itemsize for x in d) / sum(x.id.get_storage_size() for x in d))' "$out/$name.real.h5")
+  # The platform of the real runs: this machine, where a write (by a thread of its own, the
+  # appender's) first waits for a core that n - 1 counting ranks share.
+  wait_s=$("$root/build/release/tests/scale/core_wait" $((n - 1)) | sed -n 's/^core_wait_s=//p')
+  sed "s|<prop id=\"op_latency\" value=\"[^\"]*\"/>|<prop id=\"op_latency\" value=\"$wait_s\"/>|" tests/scale/local.xml >"$out/local.$n.xml"
+  echo "node-0:$n" >"$out/hosts"
+  smpirun -np "$n" -platform "$out/local.$n.xml" -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$name.$n.bin" \
+    --node-ranks "$node_ranks" --granule "$granule" --startup-seconds 0 --serve-every 1e-9 --server-serve-every 1e-9 \
+    --compress-mbps "$(sed -n 's/.*raw_bytes=\([0-9]*\) seconds=\([^ ]*\).*/\1 \2/p' <<<"$codec" | awk '{ printf "%.0f", $1 / $2 / 1e6 }')" \
+    --compress-ratio "$ratio" --index-us-per-tile "$INDEX_US_PER_TILE" --copy-gbps "$COPY_GBPS" \
+    --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no --cfg=smpi/iprobe:0 \
+    --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536 >"$out/$name.$n.sim" 2>"$out/$name.$n.log"
+  rm -f "$out/$name.$n.bin"
+  echo "ranks=$n a write's wait for a core (core_wait $((n - 1))): $wait_s s" >&2
+  /usr/bin/python3 tests/scale/compare_counts.py "$n" "$out/$name.$n.real" "$out/$name.$n.sim"
+}
+
+status=0
 for c in "${cases[@]}"; do
   job=${c%%:*}
   name=$(basename "$job" .toml)
@@ -101,8 +163,13 @@ for c in "${cases[@]}"; do
   read -r ns_per_iteration < <(/usr/bin/python3 tests/scale/sample_model.py "$out/$name.low.h5" "$seconds" "$tiles" \
     "$NS_PER_POINT" "$US_PER_TILE" "$NS_PER_ITERATION")
   for n in ${c#*:}; do
+    if [[ -n $oversubscribed ]]; then
+      compare_counts "$name" "$job" "$n" "$ns_per_iteration" || status=1
+      continue
+    fi
     real=$(computed "$job" "$n" 2>"$out/$name.$n.real")
     model=$(predicted "$name" "$job" "$n" "$ns_per_iteration")
     /usr/bin/python3 -c "print(f'job=$name ranks=$n real_s=$real predicted_s={$model:.3f} error={($model - $real) / $real:+.1%}  ($(sed 's/computed.sh: /real runs: /' "$out/$name.$n.real"); sample {$seconds} s; ns_per_iteration=$ns_per_iteration)')"
   done
 done
+exit $status

@@ -192,6 +192,35 @@ void expect_stopped_and_resumed(const Job& job, ExploreSettings s, const Data& w
     }
 }
 
+// The schedule's figures (explore --stats, what tests/scale/validate.sh --oversubscribed
+// compares with the simulation): every tile counted once, by every rank below 64, and
+// node leaders exactly when the ranks form several nodes (here pseudo-nodes, --node-ranks).
+TEST(RunExplore, ScheduleFiguresCountEveryTileOnce)
+{
+    const SharedDir dir;
+    const Job job = job_of();
+    for (const int node_ranks : {0, 2}) {
+        ExploreSettings s = settings(dir / ("nodes" + std::to_string(node_ranks) + ".h5"));
+        s.node_ranks = node_ranks;
+        Tally tally;
+        const RunSummary r = run_explore(job, s, world, tally, never);
+        ASSERT_TRUE(r.complete);
+        const ScheduleFigures& f = r.schedule;
+        if (world.is_root()) {
+            EXPECT_EQ(f.tiles, tally.start.tiles);
+        }
+        EXPECT_EQ(f.computing_ranks, world.size());
+        EXPECT_LE(f.tiles_min, f.tiles_max);
+        EXPECT_GE(f.tiles_max * static_cast<std::uint64_t>(world.size()), f.tiles);
+        EXPECT_GE(f.root_blocks, 1u);
+        // Pseudo-nodes of 2: several from 3 ranks on (one rank a node gains nothing from a leader).
+        EXPECT_EQ(f.two_level, node_ranks == 2 && world.size() > 2) << "node_ranks " << node_ranks;
+        if (world.size() == 1) {
+            EXPECT_EQ(f.root_messages, 0u);
+        }
+    }
+}
+
 // Tiles handed out interleaved (as from 64 ranks on, job/tiles.hpp handout_order), here at
 // any rank count: the same result, and a stopped run resumes to it (its incomplete
 // granules go last).
