@@ -17,8 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
-
 std::uint64_t size_of(const fs::path& p)
 {
     std::error_code ec;
@@ -40,8 +38,10 @@ FinishReport finish_result(const fs::path& partial, const fs::path& output, cons
         if (layout.compressed) {
             const h5::Id counts = h5::open_dataset(file.file(), layout::wall_bounces);
             const h5::Id outcomes = h5::open_dataset(file.file(), layout::outcome);
+            std::vector<hsize_t> origin;  // one buffer for every tile: this loop runs once a chunk
             for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-                const std::vector<hsize_t> origin = to_hsize(tiling.box(t).start);
+                const Box box = tiling.box(t);
+                origin.assign(box.start.begin(), box.start.end());
                 const StoredChunk& s = journal.stored[t];
                 file.add(counts, origin, s.address, s.counts_bytes);
                 file.add(outcomes, origin, s.address + s.counts_bytes, s.outcomes_bytes);

@@ -395,7 +395,8 @@ void PlacedChunks::add(hid_t dataset, const std::vector<hsize_t>& origin, std::u
     const herr_t r = H5Dwrite_chunk(dataset, H5P_DEFAULT, 0, origin.data(), bytes, &unused);
     const bool placed = s.allocated && s.skipped;
     s.expect_at = HADDR_UNDEF;
-    h5::check(r, fmt::format("indexing the chunk of {} bytes at byte {}", bytes, address));
+    // The message only when it fails: this runs once a chunk, a million times in a large run.
+    if (r < 0) h5::check(r, fmt::format("indexing the chunk of {} bytes at byte {}", bytes, address));
     if (!placed) {
         throw h5::Error(fmt::format("HDF5 did not index the chunk of {} bytes at byte {} where it lies", bytes, address));
     }
