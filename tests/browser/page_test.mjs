@@ -51,8 +51,11 @@ try {
     }
   });
   page.on("requestfailed", (r) => {
-    // Leaflet drops tiles it no longer needs; the browser reports them as aborted.
-    if (!(r.url().includes("/tile/") && r.failure()?.errorText === "net::ERR_ABORTED")) {
+    // Leaflet drops tiles it no longer needs, and the page the count of a position the
+    // pointer has left (app.js: a new readout aborts the one in flight); the browser reports
+    // both as aborted.
+    const dropped = r.url().includes("/tile/") || r.url().includes("/api/count?");
+    if (!(dropped && r.failure()?.errorText === "net::ERR_ABORTED")) {
       report.errors.push("request failed: " + r.url() + " " + r.failure()?.errorText);
     }
   });
@@ -66,6 +69,22 @@ try {
                all: at.length };
     }, zoom);
   };
+  // The map at rest: no move for 300 ms (a drag's inertia, a zoom's animation can outlast
+  // the events the steps wait for on a loaded machine, and a point computed from the view
+  // would then be clicked somewhere else).
+  const settled = () => page.evaluate(() => new Promise((done) => {
+    const m = window.explorer.map;
+    let timer = setTimeout(finish, 300);
+    function finish() {
+      m.off("move zoom", again);
+      done();
+    }
+    function again() {
+      clearTimeout(timer);
+      timer = setTimeout(finish, 300);
+    }
+    m.on("move zoom", again);
+  }));
   const mapState = () => page.evaluate(() => {
     const m = window.explorer.map;
     return { zoom: m.getZoom(), center: m.getCenter() };
@@ -110,7 +129,12 @@ try {
   await page.mouse.move(cx, cy);
   await page.mouse.down();
   for (let k = 1; k <= 10; ++k) await page.mouse.move(cx + 20 * k, cy - 15 * k);
+  // Held still before the release: Leaflet keeps the pointer's positions of the last 50 ms
+  // for the drag's inertia, so the map stops where it was dragged (a release mid-motion
+  // would glide on, farther on a loaded machine, whose timing then decides the view).
+  await new Promise((r) => setTimeout(r, 200));
   await page.mouse.up();
+  await settled();
   const panned = await mapState();
   report.pan = { before: first.center, after: panned.center, scale: Math.pow(2, panned.zoom) };
 
@@ -127,6 +151,7 @@ try {
     await page.click(".leaflet-control-zoom-out");
     await page.waitForFunction((z) => window.explorer.map.getZoom() === z, {}, z);
   }
+  await settled();
   const zoomed = await mapState();
   report.zoom = { before: first.zoom, wheeled, after: zoomed.zoom, tiles: await tilesLoaded(zoomed.zoom) };
   check(report.zoom.tiles.loaded > 0 && report.zoom.tiles.loaded === report.zoom.tiles.all,
@@ -143,45 +168,73 @@ try {
     return { sw: c(b.getSouthWest()), ne: c(b.getNorthEast()) };
   });
   report.visible = zoomView;
-  const probe = { xi: zoomView.sw.x + 0.3 * (zoomView.ne.x - zoomView.sw.x),
-                  W: zoomView.sw.y + 0.4 * (zoomView.ne.y - zoomView.sw.y) };
-  const p = await pointOf(probe.xi, probe.W);
+  // Points inside the view and inside the launches (0 < xi < 1, the job's W in [-3, 3]).
+  const inView = (fx, fy) => {
+    const x0 = Math.max(zoomView.sw.x, 0), x1 = Math.min(zoomView.ne.x, 1);
+    const y0 = Math.max(zoomView.sw.y, -3), y1 = Math.min(zoomView.ne.y, 3);
+    return { xi: x0 + fx * (x1 - x0), W: y0 + fy * (y1 - y0) };
+  };
+  // The pixels of the tile image at page point (x, y) (it and its 8 neighbours), read back
+  // from the image itself through a canvas (same origin), as #rrggbb; null if no tile.
+  const pixelsAt = (x, y) => page.evaluate((x, y) => {
+    // Tiles take no pointer events (elementsFromPoint passes them by): the loaded tile of
+    // the current zoom whose box holds the point.
+    const zoom = window.explorer.map.getZoom();
+    const img = [...document.querySelectorAll(".leaflet-tile-container img.leaflet-tile-loaded")].find((e) => {
+      const b = e.getBoundingClientRect();
+      return e.src.includes(`/tile/${zoom}/`) && x >= b.left && x < b.right && y >= b.top && y < b.bottom;
+    });
+    if (!img) return null;
+    const r = img.getBoundingClientRect();
+    const canvas = document.createElement("canvas");
+    canvas.width = img.naturalWidth;
+    canvas.height = img.naturalHeight;
+    const ctx = canvas.getContext("2d");
+    ctx.drawImage(img, 0, 0);
+    const ix = Math.floor((x - r.left) * img.naturalWidth / r.width), iy = Math.floor((y - r.top) * img.naturalHeight / r.height);
+    const hex = (d) => "#" + [d[0], d[1], d[2]].map((v) => v.toString(16).padStart(2, "0")).join("");
+    const out = [];
+    for (let dy = -1; dy <= 1; ++dy) {
+      for (let dx = -1; dx <= 1; ++dx) out.push(hex(ctx.getImageData(ix + dx, iy + dy, 1, 1).data));
+    }
+    return out;
+  }, x, y);
+  // The probe: the first of a few points of the view that lies inside a region (its 3 x 3
+  // pixels of one colour), so that the pixel under it has one count's colour.
+  let p = null;
+  for (const [fx, fy] of [[0.3, 0.4], [0.35, 0.45], [0.25, 0.35], [0.4, 0.3], [0.45, 0.55], [0.2, 0.6], [0.55, 0.25]]) {
+    const probe = inView(fx, fy);
+    p = await pointOf(probe.xi, probe.W);
+    const around = await pixelsAt(mapBox.x + p.x, mapBox.y + p.y);
+    if (around && new Set(around).size === 1) break;
+  }
   await readoutAt(mapBox.x + p.x, mapBox.y + p.y);
   report.readout = {
     text: await page.$eval("#readout", (e) => e.textContent),
     start: await page.evaluate(() => window.explorer.readoutStart),
-    // The pixels of the tile image under the pointer (it and its 8 neighbours), read back
-    // from the image itself through a canvas (same origin), as #rrggbb.
-    pixels: await page.evaluate((x, y) => {
-      // Tiles take no pointer events (elementsFromPoint passes them by): the loaded tile of
-      // the current zoom whose box holds the point.
-      const zoom = window.explorer.map.getZoom();
-      const img = [...document.querySelectorAll(".leaflet-tile-container img.leaflet-tile-loaded")].find((e) => {
-        const b = e.getBoundingClientRect();
-        return e.src.includes(`/tile/${zoom}/`) && x >= b.left && x < b.right && y >= b.top && y < b.bottom;
-      });
-      if (!img) return null;
-      const r = img.getBoundingClientRect();
-      const canvas = document.createElement("canvas");
-      canvas.width = img.naturalWidth;
-      canvas.height = img.naturalHeight;
-      const ctx = canvas.getContext("2d");
-      ctx.drawImage(img, 0, 0);
-      const ix = Math.floor((x - r.left) * img.naturalWidth / r.width), iy = Math.floor((y - r.top) * img.naturalHeight / r.height);
-      const hex = (d) => "#" + [d[0], d[1], d[2]].map((v) => v.toString(16).padStart(2, "0")).join("");
-      const out = [];
-      for (let dy = -1; dy <= 1; ++dy) {
-        for (let dx = -1; dx <= 1; ++dx) out.push(hex(ctx.getImageData(ix + dx, iy + dy, 1, 1).data));
-      }
-      return out;
-    }, mapBox.x + p.x, mapBox.y + p.y),
+    pixels: await pixelsAt(mapBox.x + p.x, mapBox.y + p.y),
   };
 
-  // Click: the trajectory is drawn and the ball moves.
-  const q = await pointOf(zoomView.sw.x + 0.2 * (zoomView.ne.x - zoomView.sw.x),
-                          zoomView.sw.y + 0.3 * (zoomView.ne.y - zoomView.sw.y));
-  await page.mouse.click(mapBox.x + q.x, mapBox.y + q.y);
-  await page.waitForFunction(() => /wall bounce/.test(document.getElementById("trajectory-info").textContent));
+  // Click: the trajectory is drawn and the ball moves. The click must start the launch
+  // aimed at (within a pixel's worth of the view): clicked again, at the point as the map
+  // now shows it, if the map had not come to rest.
+  const aim = inView(0.2, 0.3);
+  const pixel = (zoomView.ne.x - zoomView.sw.x) / mapBox.width;
+  for (let attempt = 0; ; ++attempt) {
+    await settled();
+    const q = await pointOf(aim.xi, aim.W);
+    await page.mouse.click(mapBox.x + q.x, mapBox.y + q.y);
+    const start = await page.evaluate(() => window.explorer.trajectoryStart);
+    if (start && Math.abs(start.xi - aim.xi) < 2 * pixel) break;
+    if (attempt == 2) throw new Error("the click did not start the launch aimed at: " + JSON.stringify({ aim, start }));
+  }
+  try {
+    await page.waitForFunction(() => /wall bounce/.test(document.getElementById("trajectory-info").textContent));
+  } catch (err) {
+    const text = await page.$eval("#trajectory-info", (e) => e.textContent);
+    const start = await page.evaluate(() => JSON.stringify(window.explorer.trajectoryStart));
+    throw new Error(`no trajectory after the click: trajectory-info ${JSON.stringify(text)}, start ${start}: ${err.message}`);
+  }
   const ball = () => page.$eval("#trajectory .ball", (b) => [Number(b.getAttribute("cx")), Number(b.getAttribute("cy"))]);
   const b0 = await ball();
   await new Promise((r) => setTimeout(r, 400));
