@@ -86,27 +86,36 @@ node_ranks=16
 computed() {  # compute-phase seconds of real runs, the median of REPS: JOB RANKS
   tests/scale/computed.sh "$superball" "$1" "$reps" "$2" "$out/real.h5"
 }
-predicted() {  # schedule_s of the simulation: NAME JOB RANKS NS_PER_ITERATION
-  local line granule write
-  line=$("$scale_costs" "$2" "$3" "$out/$1.low.h5" "$NS_PER_POINT" "$4" "$US_PER_TILE" "$out/$1.$3.bin")
-  granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' <<<"$line")
-  # Each tile's compression charged as simulate.sh charges it (the real runs compress), and
-  # the payloads of the size the last real run at this rank count stored ($out/real.h5).
-  local codec
-  codec=$("$root/build/release/tests/scale/codec_speed" "$out/real.h5" "$(sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$line")" 2>/dev/null || true)
+compression_of() { sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$1"; }  # scale_costs' LINE
+# SMPI's settings for every simulation here.
+smpi_cfg=(--cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no --cfg=smpi/iprobe:0
+          --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536)
+# sim_run's write options in the array `write`: each tile's compression charged as
+# simulate.sh charges it (CODEC: codec_speed's line; 650 MB/s without one) and payloads of
+# the size the real result RESULT stored; --uncompressed where scale_costs' LINE says so.
+# RESULT LINE CODEC
+sim_write_args() {
   write=(--compress-mbps "$(/usr/bin/python3 -c '
 import re, sys
 m = re.search(r"raw_bytes=(\d+) seconds=(\S+)", sys.argv[1])
-print(f"{int(m.group(1)) / float(m.group(2)) / 1e6:.0f}" if m else 650)' "$codec")" --compress-ratio "$(/usr/bin/python3 -c '
+print(f"{int(m.group(1)) / float(m.group(2)) / 1e6:.0f}" if m else 650)' "$3")" --compress-ratio "$(/usr/bin/python3 -c '
 import sys, h5py
 with h5py.File(sys.argv[1]) as f:
     d = [f["wall_bounces"], f["outcome"]]
-    print(sum(x.size * x.dtype.itemsize for x in d) / sum(x.id.get_storage_size() for x in d))' "$out/real.h5")")
-  [[ $(sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$line") == 0 ]] && write=(--uncompressed)
+    print(sum(x.size * x.dtype.itemsize for x in d) / sum(x.id.get_storage_size() for x in d))' "$1")")
+  [[ $(compression_of "$2") == 0 ]] && write=(--uncompressed)
+  return 0
+}
+predicted() {  # schedule_s of the simulation: NAME JOB RANKS NS_PER_ITERATION
+  local line granule write codec
+  line=$("$scale_costs" "$2" "$3" "$out/$1.low.h5" "$NS_PER_POINT" "$4" "$US_PER_TILE" "$out/$1.$3.bin")
+  granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' <<<"$line")
+  # The payloads of the size the last real run at this rank count stored ($out/real.h5).
+  codec=$("$root/build/release/tests/scale/codec_speed" "$out/real.h5" "$(compression_of "$line")" 2>/dev/null || true)
+  sim_write_args "$out/real.h5" "$line" "$codec"
   echo "node-0:$3" >"$out/hosts"
   smpirun -np "$3" -platform tests/scale/local.xml -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$1.$3.bin" \
-    --node-ranks "$3" --granule "$granule" "${write[@]}" --no-io --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no \
-    --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536 2>"$out/$1.$3.log" |
+    --node-ranks "$3" --granule "$granule" "${write[@]}" --no-io "${smpi_cfg[@]}" 2>"$out/$1.$3.log" |
     sed -n 's/.* schedule_s=\([^ ]*\).*/\1/p'
   rm -f "$out/$1.$3.bin"
 }
@@ -114,7 +123,7 @@ with h5py.File(sys.argv[1]) as f:
 # The real runs' counts (medians of REPS runs) against the simulation's, one
 # line each: NAME JOB RANKS NS_PER_ITERATION.
 compare_counts() {
-  local name=$1 job=$2 n=$3 ns=$4 r line granule codec ratio writes wait_s
+  local name=$1 job=$2 n=$3 ns=$4 r line granule codec write writes wait_s
   # The schedule's counts from REPS plain runs; the write calls from one more under strace
   # (which stops the process at every write: no timing of it is kept).
   : >"$out/$name.$n.real"
@@ -127,12 +136,8 @@ compare_counts() {
   sed -i "s/\$/ $writes/" "$out/$name.$n.real"
   line=$("$scale_costs" "$job" "$n" "$out/$name.low.h5" "$NS_PER_POINT" "$ns" "$US_PER_TILE" "$out/$name.$n.bin")
   granule=$(sed -n 's/.* granule=\([0-9]*\) .*/\1/p' <<<"$line")
-  codec=$("$root/build/release/tests/scale/codec_speed" "$out/$name.real.h5" "$(sed -n 's/.* compression=\([0-9]*\).*/\1/p' <<<"$line")")
-  ratio=$(/usr/bin/python3 -c '
-import sys, h5py
-with h5py.File(sys.argv[1]) as f:
-    d = [f["wall_bounces"], f["outcome"]]
-    print(sum(x.size * x.dtype.itemsize for x in d) / sum(x.id.get_storage_size() for x in d))' "$out/$name.real.h5")
+  codec=$("$root/build/release/tests/scale/codec_speed" "$out/$name.real.h5" "$(compression_of "$line")")
+  sim_write_args "$out/$name.real.h5" "$line" "$codec"
   # The platform of the real runs: this machine, where a write (by a thread of its own, the
   # appender's) first waits for a core that n - 1 counting ranks share.
   wait_s=$("$root/build/release/tests/scale/core_wait" $((n - 1)) | sed -n 's/^core_wait_s=//p')
@@ -140,10 +145,8 @@ with h5py.File(sys.argv[1]) as f:
   echo "node-0:$n" >"$out/hosts"
   smpirun -np "$n" -platform "$out/local.$n.xml" -hostfile "$out/hosts" "$root/build/scale/sim_run" "$out/$name.$n.bin" \
     --node-ranks "$node_ranks" --granule "$granule" --startup-seconds 0 --serve-every 1e-9 --server-serve-every 1e-9 \
-    --compress-mbps "$(sed -n 's/.*raw_bytes=\([0-9]*\) seconds=\([^ ]*\).*/\1 \2/p' <<<"$codec" | awk '{ printf "%.0f", $1 / $2 / 1e6 }')" \
-    --compress-ratio "$ratio" --index-us-per-tile "$INDEX_US_PER_TILE" --copy-gbps "$COPY_GBPS" \
-    --cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no --cfg=smpi/iprobe:0 \
-    --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536 >"$out/$name.$n.sim" 2>"$out/$name.$n.log"
+    "${write[@]}" --index-us-per-tile "$INDEX_US_PER_TILE" --copy-gbps "$COPY_GBPS" "${smpi_cfg[@]}" \
+    >"$out/$name.$n.sim" 2>"$out/$name.$n.log"
   rm -f "$out/$name.$n.bin"
   echo "ranks=$n a write's wait for a core (core_wait $((n - 1))): $wait_s s" >&2
   /usr/bin/python3 tests/scale/compare_counts.py "$n" "$out/$name.$n.real" "$out/$name.$n.sim"
