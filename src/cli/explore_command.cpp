@@ -150,8 +150,10 @@ int explore(const ExploreOptions& opt)
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() >= opt.stop_after);
         };
         const RunSummary r = run_explore(job, settings, world, progress, stop);
-        if (root && !r.nothing_to_do) print_summary(job, r, kernel);
-        if (root && !r.nothing_to_do && opt.stats) print_schedule(r.schedule);
+        if (root && !r.nothing_to_do) {
+            print_summary(job, r, kernel);
+            if (opt.stats) print_schedule(r.schedule);
+        }
         return r.interrupted ? 1 : 0;
     });
 }
