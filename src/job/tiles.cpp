@@ -106,7 +106,7 @@ std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks)
 {
     const auto r = static_cast<std::uint64_t>(std::max(ranks, 1));
     if (r >= interleave_ranks_default) {
-        return std::clamp<std::uint64_t>(grid_points / (256 * r), 1024, std::uint64_t{1} << 16);
+        return std::clamp<std::uint64_t>(grid_points / (512 * r), 1024, std::uint64_t{1} << 16);
     }
     // At least 4 tiles per rank, and tiles of 2^17 points where that leaves so many.
     const std::uint64_t floor = std::clamp<std::uint64_t>(grid_points / (4 * r), 1024, std::uint64_t{1} << 17);

@@ -97,11 +97,12 @@ Extent default_tile_shape(const Extent& shape, std::uint64_t target_points);
 //   points while that leaves 4 tiles per rank (the 1024^2 quickstart slice on 2 ranks: 8
 //   tiles of 2^17 points, a 53 KB result; in 32 tiles of 2^15, 56 KB; its compute phase
 //   takes 10 ms either way), and never below 1024 points.
-// - From 64 ranks on: 256 tiles per rank, 1024 to 2^16 points. The end of a run on
+// - From 64 ranks on: 512 tiles per rank, 1024 to 2^16 points. The end of a run on
 //   thousands of ranks waits for its costliest tile: the corner zoom of jobs/cluster at
 //   4096 simulated ranks counted at 0.874 of the ideal in tiles of 2^16 points and 0.967
 //   in tiles of 2^14 (tests/scale/simulate.sh); its data compress 4 times only, so a chunk's
-//   fixed bytes cost it under 1 %.
+//   fixed bytes cost it under 1 %. Not fewer: with 256 tiles per rank sweep_e_alpha's
+//   costliest tiles (7.4 s) made its end to end 0.894, 0.903 with 512 (docs/decisions.md).
 std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks);
 
 // From this many ranks on, a run hands out its tiles interleaved (handout_order).

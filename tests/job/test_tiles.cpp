@@ -88,10 +88,11 @@ TEST(DefaultTilePoints, LargeChunksOnFewRanksManyTilesOnMany)
     // Small grids: 1024 points at least.
     EXPECT_EQ(default_tile_points(64 * 64, 2), k);
     EXPECT_EQ(default_tile_points(10, 1), k);
-    // From 64 ranks: 256 tiles a rank, at most 2^16 points.
-    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 2048 * 2048, 4096), 16 * k);
-    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 2048 * 2048, 1024), 64 * k);
-    EXPECT_EQ(default_tile_points(8192 * 8192, 64), 4 * k);
+    // From 64 ranks: 512 tiles a rank, at most 2^16 points.
+    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 2048 * 2048, 4096), 8 * k);
+    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 2048 * 2048, 1024), 32 * k);
+    EXPECT_EQ(default_tile_points(std::uint64_t{4096} * 4096 * 4096, 1024), 64 * k);
+    EXPECT_EQ(default_tile_points(8192 * 8192, 64), 2 * k);
 }
 
 TEST(HandoutOrder, NothingPending)
