@@ -166,16 +166,17 @@ EOF
   # 1. The low-resolution sample, computed again only when the job changed (tile_points
   #    and output aside: lowres_job.py leaves them out). The candidate's name holds this
   #    process's id: two simulations of one job started together raced on a shared one.
-  /usr/bin/python3 tests/scale/lowres_job.py "$job" "$out/lowres/$lowname.next.$$.toml" "$out/lowres/$lowname.h5" \
+  next=$out/lowres/$lowname.next.$$.toml
+  /usr/bin/python3 tests/scale/lowres_job.py "$job" "$next" "$out/lowres/$lowname.h5" \
     --points "$sample_points"
-  sed -i "1s|.*|# Lower-resolution sample of $name for the scaling simulation (tests/scale/lowres_job.py).|" "$out/lowres/$lowname.next.$$.toml"
-  if ! cmp -s "$out/lowres/$lowname.next.$$.toml" "$out/lowres/$lowname.toml" || [[ ! -f $out/lowres/$lowname.seconds ]]; then
-    mv "$out/lowres/$lowname.next.$$.toml" "$out/lowres/$lowname.toml"
+  sed -i "1s|.*|# Lower-resolution sample of $name for the scaling simulation (tests/scale/lowres_job.py).|" "$next"
+  if ! cmp -s "$next" "$out/lowres/$lowname.toml" || [[ ! -f $out/lowres/$lowname.seconds ]]; then
+    mv "$next" "$out/lowres/$lowname.toml"
     echo "simulate: computing $out/lowres/$lowname.toml at -n 1 (3 runs; on a machine doing nothing else)" >&2
     tests/scale/computed.sh "$superball" "$out/lowres/$lowname.toml" 3 >"$out/lowres/$lowname.seconds" ||
       { rm -f "$out/lowres/$lowname.seconds"; echo "simulate: $out/lowres/$lowname.toml failed" >&2; exit 1; }
   else
-    rm "$out/lowres/$lowname.next.$$.toml"
+    rm "$next"
   fi
   # The job's cost per wall bounce, from its sample.
   tiles=$("$superball" explore "$out/lowres/$lowname.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
