@@ -390,7 +390,10 @@ class LoadTest(unittest.TestCase):
     """Slow, abandoned and concurrent requests on a server with 2 counting threads."""
 
     def test_slow_request_is_bounded_and_stalls_no_one(self):
-        with Server("--threads", "2", "--time-limit", "1") as server:
+        # A limit of 3 s, so that several fast requests fit beside the slow one wherever the
+        # test runs (with 1 s, the sanitized build beside other work answered 2, of up to
+        # 568 ms each).
+        with Server("--threads", "2", "--time-limit", "3") as server:
             slow = dict(CAPPED, nx=512, ny=512, max_bounces=1000000)  # hours of work
             result = {}
 
@@ -412,12 +415,11 @@ class LoadTest(unittest.TestCase):
             thread.join()
             status, body = result["answer"]
             self.assertEqual(status, 503, body)
-            self.assertIn("took longer than the server's time limit of 1 s", body["error"])
-            self.assertLess(result["seconds"], 1 + 2 * SLOWER)
+            self.assertIn("took longer than the server's time limit of 3 s", body["error"])
+            self.assertLess(result["seconds"], 3 + 2 * SLOWER)
             print(f"\nfast requests beside the slow one: {len(fast)}, at most {1e3 * max(fast):.0f} ms")
-            # Answered while the slow one ran, each within the bound: how many fit in its second
-            # depends on the machine (in the sanitized build beside other work, 2 of up to 568 ms).
-            self.assertGreaterEqual(len(fast), 2)
+            # Answered while the slow one ran, each within the bound.
+            self.assertGreaterEqual(len(fast), 3)
             self.assertLess(max(fast), 0.5 * SLOWER, fast)
             self.assertEqual(server.json("/api/info")[1]["stats"]["timed_out"], 1)
 
