@@ -265,9 +265,17 @@ class Faults(unittest.TestCase):
         file left as it is, or (the bytes were in a tile not yet done, or in space no
         object uses) it completes the run identical to an uninterrupted one. Never a mixture."""
         refused = 0
+        # One interrupted file, copied before each damage (making it is a run and the
+        # filling of half its tiles).
+        out = self.interrupted_copy("overwritten.h5")
+        partial = out + ".partial"
+        intact = read_bytes(partial)
         for fraction in np.linspace(0.01, 0.99, 9):
-            out = self.interrupted_copy("overwritten.h5")
-            partial = out + ".partial"
+            for leftover in (out, partial + ".undo"):  # a resumed run's result, a finish's undo log
+                if os.path.exists(leftover):
+                    os.remove(leftover)
+            with open(partial, "wb") as f:
+                f.write(intact)
             size = os.path.getsize(partial)
             with open(partial, "r+b") as f:
                 f.seek(int(size * fraction))
