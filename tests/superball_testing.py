@@ -138,6 +138,19 @@ def stored_chunk(values):
     return zlib.compress(np.ascontiguousarray(raw.T).tobytes(), 6)
 
 
+def running_journal(partial):
+    """The journal (/progress/tile_done) of a partial file that a run is writing, read in
+    this process; None while the file does not exist yet or is caught mid-creation. (Tests
+    that stop a run part-way poll it; a Python started per look spends most of a short run
+    importing h5py.)"""
+    import h5py
+    try:
+        with h5py.File(partial, "r") as f:
+            return f["progress/tile_done"][()]
+    except (OSError, KeyError):
+        return None
+
+
 def read_partial(path):
     """(counts, outcomes, done flags) of a partial file, read independently of superball:
     an uncompressed file's chunks through h5py, a compressed file's tiles from the bytes

@@ -19,7 +19,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import descendants, killable_job, mpi_env, wall_impacts_per_second  # noqa: E402
+from superball_testing import descendants, killable_job, mpi_env, running_journal, wall_impacts_per_second  # noqa: E402
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
@@ -408,16 +408,11 @@ class Explore(unittest.TestCase):
                                 env=mpi_env(), start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         done, total = 0, 1
         deadline = time.time() + 120
-        # The journal read in this process (a Python started for each look spent most of the
-        # run importing h5py: under a loaded sanitized build, the run ended before it was
-        # seen a fifth done).
         while time.time() < deadline and proc.poll() is None:
             time.sleep(0.02)
-            try:
-                with h5py.File(partial, "r") as f:
-                    journal = f["progress/tile_done"][()]
-            except (OSError, KeyError):
-                continue  # not created yet, or caught mid-creation
+            journal = running_journal(partial)
+            if journal is None:
+                continue
             done, total = int(journal.sum()), journal.size
             if done >= total // 5:
                 break

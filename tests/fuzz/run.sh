@@ -70,11 +70,12 @@ link() {
 stamp=$out/fuzz.stamp
 if [[ ! -x $out/fuzz_job || ! -x $out/fuzz_result || ! -f $stamp ]] ||
    [[ -n $(cd "$root" && find src tests/fuzz "$out/generated" -type f -newer "$stamp" -print -quit) ]]; then
-  echo "fuzz: building $out/fuzz_job and $out/fuzz_result ($(nproc) compilations at once)" >&2
+  cores=$(nproc)
+  echo "fuzz: building $out/fuzz_job and $out/fuzz_result ($cores compilations at once)" >&2
   mkdir -p "$objects"
   running=0 failed=0
   for source in tests/fuzz/fuzz_job.cpp tests/fuzz/fuzz_result.cpp "${job_sources[@]}" "${result_sources[@]}"; do
-    if ((running >= $(nproc))); then wait -n || failed=1; running=$((running - 1)); fi
+    if ((running >= cores)); then wait -n || failed=1; running=$((running - 1)); fi
     compile "$source" "$(object "$source")" &
     running=$((running + 1))
   done

@@ -36,8 +36,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import (capped_job, descendants, killable_job, mpi_env, read_partial, superball_binary,  # noqa: E402
-                               tile_boxes, wall_impacts_per_second)
+from superball_testing import (capped_job, descendants, killable_job, mpi_env, read_partial, running_journal,  # noqa: E402
+                               superball_binary, tile_boxes, wall_impacts_per_second)
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
@@ -141,13 +141,9 @@ class Signals(unittest.TestCase):
             if proc.poll() is not None:
                 with open(self.stderr_path) as f:
                     self.fail(f"the run ended (status {proc.returncode}) before it could be interrupted:\n{f.read()}")
-            try:
-                with h5py.File(output + ".partial", "r") as f:
-                    done = f["progress/tile_done"][()]
-                if done.sum() >= max(1, fraction * done.size):
-                    return int(done.sum())
-            except (OSError, KeyError):
-                pass  # not created yet, or caught mid-creation
+            done = running_journal(output + ".partial")
+            if done is not None and done.sum() >= max(1, fraction * done.size):
+                return int(done.sum())
             time.sleep(0.05)
         self.fail("no progress")
 
