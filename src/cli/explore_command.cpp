@@ -1,13 +1,12 @@
-// superball explore: parses the command line, runs the job (run/explore.hpp), prints.
+// superball explore: runs the job (run/explore.hpp) on every rank, prints the summary.
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <limits>
-#include <memory>
 
-#include "commands.hpp"
+#include "explore_command.hpp"
 #include "every_rank.hpp"
 #include "core/count.hpp"
 #include "core/kernels.hpp"
@@ -23,19 +22,6 @@ namespace superball::cli {
 namespace fs = std::filesystem;
 
 namespace {
-
-struct ExploreOptions {
-    std::string job;
-    std::string output;
-    bool resume = false;
-    bool overwrite = false;
-    bool quiet = false;
-    bool dry_run = false;
-    bool stats = false;
-    int node_ranks = 0;  // 0: the ranks sharing memory form a node
-    double stop_after = -1;  // seconds of computing, then a clean stop; < 0: none
-    std::string kernel;  // empty: $SUPERBALL_KERNEL, else the best variant
-};
 
 void print_summary(const Job& job, const RunSummary& r, const KernelVariant& kernel)
 {
@@ -126,7 +112,9 @@ void print_plan(const Job& job, const DryRun& d, int ranks)
     }
 }
 
-int explore(const ExploreOptions& opt)
+}  // namespace
+
+int explore_command(const ExploreOptions& opt)
 {
     // Before MPI starts: a signal during start-up then stops the run cleanly too.
     const StopSignals signals;
@@ -156,47 +144,6 @@ int explore(const ExploreOptions& opt)
         }
         return r.interrupted ? 1 : 0;
     });
-}
-
-}  // namespace
-
-Runner add_explore_command(CLI::App& app)
-{
-    auto* sub = app.add_subcommand("explore", "Count wall bounces over a grid of starts (run under mpirun)");
-    sub->footer(
-        "Run as `mpirun -n P superball explore JOB.toml` (P >= 1). The result is one HDF5 file in\n"
-        "netCDF-4/CF layout (xarray, ncdump, h5py read it), compressed, plus a .xmf sidecar for ParaView.\n"
-        "While the run goes on, its tiles are in OUTPUT.partial; the result takes its name only once\n"
-        "complete. An existing result is never overwritten unless --overwrite is given, and only a\n"
-        "superball file is ever replaced; --resume finishes an interrupted run of the same job (a different\n"
-        "job is refused). SIGINT/SIGTERM (or SIGUSR1/2, which mpirun forwards to every rank) stop cleanly\n"
-        "(resumable); a second signal stops at once (still resumable).");
-    auto opt = std::make_shared<ExploreOptions>();
-    sub->add_option("job", opt->job, "TOML job file (SPEC.md section 4)")->required();
-    sub->add_option("-o,--output", opt->output, "result file (default: [run] output of the job)");
-    sub->add_flag("--resume", opt->resume, "finish an interrupted run of the same job in the output file");
-    auto* overwrite = sub->add_flag("--overwrite", opt->overwrite, "replace an existing output file");
-    sub->get_option("--resume")->excludes(overwrite);
-    sub->add_flag("-q,--quiet", opt->quiet, "no progress lines");
-    sub->add_option("--stop-after", opt->stop_after,
-                    "stop cleanly after this many seconds, as on SIGTERM (resumable with --resume): a time budget for "
-                    "batch jobs")
-        ->check(CLI::NonNegativeNumber);
-    std::string variants;
-    for (const KernelVariant& k : simd_kernels()) variants += (variants.empty() ? "" : ", ") + std::string(k.name);
-    sub->add_option("--kernel", opt->kernel,
-                    "counting kernel, identical results: simd (the widest variant this processor runs, here " +
-                        describe(best_kernel()) + "), scalar, or a variant of this build (" + variants +
-                        "); default: $SUPERBALL_KERNEL, else simd");
-    sub->add_flag("--stats", opt->stats,
-                  "after the run, print how the schedule went: tiles per rank (fewest, most), blocks rank 0 handed "
-                  "out, messages it received, tiles given back (the figures tests/scale/simulate.sh predicts)");
-    sub->add_option("--node-ranks", opt->node_ranks,
-                    "schedule as if every N consecutive ranks were a node (default: the ranks sharing memory): "
-                    "the cluster's two-level schedule on one machine, for tests")
-        ->check(CLI::Range(1, std::numeric_limits<int>::max()));
-    sub->add_flag("--dry-run", opt->dry_run, "check the job and print the plan (grid, tiles, output) without running");
-    return [opt] { return explore(*opt); };
 }
 
 }  // namespace superball::cli

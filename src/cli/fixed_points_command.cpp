@@ -7,11 +7,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <memory>
 #include <string>
 #include <vector>
 
-#include "commands.hpp"
+#include "fixed_points_command.hpp"
 #include "every_rank.hpp"
 #include "job/result_json.hpp"
 #include "core/dynamics.hpp"
@@ -22,16 +21,6 @@
 namespace superball::cli {
 
 namespace {
-
-struct FixedPointOptions {
-    ModelInput model;
-    int period = 1;
-    std::int64_t starts = 2000;
-    std::uint64_t seed = 1;
-    std::string format = "table";
-    std::string output;
-    bool corner = false;
-};
 
 void validate(const FixedPointOptions& opt)
 {
@@ -92,7 +81,9 @@ void write_json(std::FILE* f, const std::vector<Cycle>& cycles, const Model& mod
     fmt::print(f, "{}\n", out.dump(1));
 }
 
-int run(const FixedPointOptions& opt)
+}  // namespace
+
+int fixed_points_command(const FixedPointOptions& opt)
 {
     const mpi::Environment env;
     const mpi::Comm world = mpi::Comm::world();
@@ -116,34 +107,6 @@ int run(const FixedPointOptions& opt)
         }
     });
     return 0;
-}
-
-}  // namespace
-
-Runner add_fixed_points_command(CLI::App& app)
-{
-    auto* sub = app.add_subcommand("fixed-points", "Fixed points and cycles of the canonical map (self-similar motions)");
-    sub->footer(
-        "Solves G^k(s) = s for k = 1..--period by damped Newton's method from --starts seeded starts in\n"
-        "0 < xi < 1, U < 0, keeping the solutions whose whole cycle stays there (residual <= 1e-10).\n"
-        "For each distinct cycle: its period, the point with the smallest xi, the product lambda of the\n"
-        "multipliers (scale factor per period), the eigenvalues of the Jacobian of G^k and the stability\n"
-        "(stable, unstable, saddle, marginal: some |eigenvalue| within 1e-9 of 1). Under mpirun the starts\n"
-        "are shared among the ranks; the result does not depend on their number.\n"
-        "--corner also looks for cycles on the corner plane xi = 0, where the wall sends the ball down\n"
-        "and G maps the plane into itself: the limits of motions that go into the corner. Their\n"
-        "eigenvalues include the transverse multiplier kappa = d xi'/d xi (< 1: nearby launches approach\n"
-        "the corner, with infinitely many bounces).\n"
-        "Example: superball fixed-points --e 0.9 --alpha 1 --period 3 --format json");
-    auto opt = std::make_shared<FixedPointOptions>();
-    add_model_flags(*sub, opt->model);
-    sub->add_option("--period", opt->period, "largest period k to look for, 1..8")->capture_default_str();
-    sub->add_option("--starts", opt->starts, "number of Newton starts, >= 1")->capture_default_str();
-    sub->add_option("--seed", opt->seed, "seed of the random starts (std::mt19937_64)")->capture_default_str();
-    sub->add_option("--format", opt->format, "table or json")->capture_default_str();
-    sub->add_option("-o,--output", opt->output, "write to this file instead of standard output");
-    sub->add_flag("--corner", opt->corner, "also look for cycles on the corner plane xi = 0");
-    return [opt] { return run(*opt); };
 }
 
 }  // namespace superball::cli

@@ -1,7 +1,7 @@
-// Command-line options shared by the subcommands: the model flags and the start point.
+// What the subcommands share once their options are parsed: the flags' spelling in messages,
+// the start point, the output file.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
@@ -16,16 +16,10 @@ namespace superball::cli {
 // "--e-wall" for the key "e_wall".
 std::string flag_spelling(std::string_view key);
 
-void add_model_flags(CLI::App& app, ModelInput& in);
-
 using StartFlags = StartInput;
-
-void add_start_flags(CLI::App& app, StartFlags& in);
 
 // resolve_start() with the flags' spelling.
 Start resolve_start(const StartFlags& in);
-
-void add_max_bounces_flag(CLI::App& app, std::uint32_t& max_bounces);
 
 // Runs write(f) on standard output, or on the file `path` when it is not empty (-o); throws
 // std::runtime_error("cannot write PATH") when the file cannot be opened or closed.

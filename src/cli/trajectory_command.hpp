@@ -1,0 +1,25 @@
+// superball trajectory: every impact of one start point (CSV or JSON).
+// main.cpp (the only file that knows the command line) parses the options into the struct;
+// the function runs the command: returns the process exit status, throws InputError for bad
+// input (status 2).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/input.hpp"
+
+namespace superball::cli {
+
+struct TrajectoryOptions {
+    ModelInput model;
+    StartInput start;
+    std::uint32_t max_bounces = 1000;
+    std::string format = "csv";
+    int samples = 0;
+    std::string output;
+};
+
+int trajectory_command(const TrajectoryOptions& opt);
+
+}  // namespace superball::cli
