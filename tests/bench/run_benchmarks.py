@@ -227,7 +227,7 @@ def main():
     if native:
         print(f"native build ({native.dir}): {native.version}")
     print(f"{a.repetitions} interleaved repetitions; medians, [smallest, largest] of the ratios", flush=True)
-    r = {key: [] for key in ("kernel", "native_kernel", "n1", "n2", "p8192", "n8192", "s1_8192", "s2_8192", "scalar",
+    r = {key: [] for key in ("kernel", "native_kernel", "n1", "n2", "p8192", "n8192", "s1_8192", "s2_8192", "single_8192", "scalar",
                              "tile1024", "tile262144", "calls", "single", "single_before", "mpirun", "mpirun_before",
                              "n2_16384", "volume", "refine_slice", "refine_volume", "full_slice", "coarse_slice",
                              "full_volume", "coarse_volume")}
@@ -268,6 +268,8 @@ def main():
             # Issue 21: the whole process on the 8192^2 slice at 1 and 2 ranks, and the
             # scalar kernel counting the same points in a plain loop.
             pair("s1_8192", lambda: ex.run(portable, slice_8192, 1), "s2_8192", lambda: ex.run(portable, slice_8192, 2))
+            # The same rank alone, without mpirun (a singleton: what mpirun and its daemon cost).
+            r["single_8192"].append(ex.run(portable, slice_8192, 1, singleton=True))
             r["scalar"].append(scalar_loop(portable, 0.1))
             # Issue 14: the portable binary against the native build, one rank, 8192^2.
             if native:
@@ -341,6 +343,10 @@ def main():
         ratio_line(f"  explore -n {ranks}: wall / its own compute phase", [x["wall"] / x["compute"] for x in r[key]],
                    "{:.2f}x", f"{median([x['wall'] for x in r[key]]):.2f} s against "
                    f"{median([x['compute'] for x in r[key]]):.2f} s; target <= 1.15")
+    ratio_line("  explore, one rank without mpirun (singleton): wall / its own compute phase",
+               [x["wall"] / x["compute"] for x in r["single_8192"]], "{:.2f}x",
+               f"{median([x['wall'] for x in r['single_8192']]):.2f} s against "
+               f"{median([x['compute'] for x in r['single_8192']]):.2f} s (for comparison with -n 1)")
     ratio_line("  explore -n 1 / scalar kernel in a plain loop, one core",
                [r["s1_8192"][i]["wall"] / r["scalar"][i]["seconds"] for i in reps], "{:.2f}x",
                f"{median([x['seconds'] for x in r['scalar']]):.2f} s for the loop; totals of wall bounces "
