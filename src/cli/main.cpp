@@ -121,6 +121,14 @@ void add_max_bounces_flag(CLI::App& app, std::uint32_t& max_bounces)
         ->capture_default_str();
 }
 
+// The flags of the commands that follow one start point (count, trajectory).
+void add_one_start_flags(CLI::App& app, ModelInput& model, StartInput& start, std::uint32_t& max_bounces)
+{
+    add_model_flags(app, model);
+    add_start_flags(app, start);
+    add_max_bounces_flag(app, max_bounces);
+}
+
 // One function per subcommand: its options, and the function that runs it.
 Runner add_count_command(CLI::App& app)
 {
@@ -131,9 +139,7 @@ Runner add_count_command(CLI::App& app)
         "missed (it landed on the floor before reaching the wall), capped (--max-bounces reached),\n"
         "invalid (not a launch toward the wall).");
     auto opt = std::make_shared<CountOptions>();
-    add_model_flags(*sub, opt->model);
-    add_start_flags(*sub, opt->start);
-    add_max_bounces_flag(*sub, opt->max_bounces);
+    add_one_start_flags(*sub, opt->model, opt->start, opt->max_bounces);
     sub->add_flag("--json", opt->json, "print a JSON object instead of a sentence");
     return [opt] { return count_command(*opt); };
 }
@@ -147,9 +153,7 @@ Runner add_trajectory_command(CLI::App& app)
         "leaving. A canonical start is followed in dimensionless units (v0 = g = radius = 1, so omega = W);\n"
         "a physical start in SI units. --samples K adds K points on every flight (event 'path') for plotting.");
     auto opt = std::make_shared<TrajectoryOptions>();
-    add_model_flags(*sub, opt->model);
-    add_start_flags(*sub, opt->start);
-    add_max_bounces_flag(*sub, opt->max_bounces);
+    add_one_start_flags(*sub, opt->model, opt->start, opt->max_bounces);
     sub->add_option("--format", opt->format, "csv or json")->check(CLI::IsMember({"csv", "json"}))->capture_default_str();
     sub->add_option("--samples", opt->samples, "points sampled on each flight parabola (0: none, otherwise >= 2)")
         ->check(CLI::Range(0, 100000));
