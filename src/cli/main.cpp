@@ -98,7 +98,7 @@ void add_model_flags(CLI::App& app, ModelInput& in)
     app.add_option("--alpha-floor", in.alpha_floor, "floor's alpha (overrides --alpha)")->group("Model");
 }
 
-void add_start_flags(CLI::App& app, StartFlags& in)
+void add_start_flags(CLI::App& app, StartInput& in)
 {
     const char* canonical = "Canonical start";
     app.add_option("--xi", in.xi, "g x / (2 |u| v): launch distance as a fraction of the free-flight range, > 0")

@@ -24,6 +24,6 @@ void write_output(const std::string& path, const std::function<void(std::FILE*)>
     if (std::fclose(file.release()) != 0) throw std::runtime_error("cannot write " + path);
 }
 
-Start resolve_start(const StartFlags& in) { return superball::resolve_start(in, flag_spelling); }
+Start resolve_start(const StartInput& in) { return superball::resolve_start(in, flag_spelling); }
 
 }  // namespace superball::cli

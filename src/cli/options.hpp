@@ -2,11 +2,10 @@
 // the start point, the output file.
 #pragma once
 
-#include <cstdint>
 #include <cstdio>
 #include <functional>
-#include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/input.hpp"
 #include "core/state.hpp"
@@ -16,10 +15,8 @@ namespace superball::cli {
 // "--e-wall" for the key "e_wall".
 std::string flag_spelling(std::string_view key);
 
-using StartFlags = StartInput;
-
 // resolve_start() with the flags' spelling.
-Start resolve_start(const StartFlags& in);
+Start resolve_start(const StartInput& in);
 
 // Runs write(f) on standard output, or on the file `path` when it is not empty (-o); throws
 // std::runtime_error("cannot write PATH") when the file cannot be opened or closed.
