@@ -5,7 +5,6 @@
 #include <complex>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
