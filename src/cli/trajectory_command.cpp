@@ -1,7 +1,6 @@
 #include <fmt/core.h>
 #include <fmt/os.h>
 
-
 #include "trajectory_command.hpp"
 #include "core/report.hpp"
 #include "job/result_json.hpp"
