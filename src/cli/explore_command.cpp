@@ -65,9 +65,9 @@ void print_schedule(const ScheduleFigures& s)
 {
     fmt::print(stderr,
                "schedule: tiles={} computing_ranks={} two_level={} tiles_min={} tiles_max={} root_blocks={} root_messages={} "
-               "root_requests={} root_asked_back={} max_leader_messages={} given_back={}\n",
+               "root_requests={} root_asked_back={} max_leader_messages={} given_back={} writers={} placed_max={}\n",
                s.tiles, s.computing_ranks, s.two_level ? 1 : 0, s.tiles_min, s.tiles_max, s.root_blocks, s.root_messages,
-               s.root_requests, s.root_asked_back, s.max_leader_messages, s.given_back);
+               s.root_requests, s.root_asked_back, s.max_leader_messages, s.given_back, s.writers, s.placed_max);
 }
 
 // What --dry-run prints: the validated job and dry_run_explore's plan, one `key: value` a
@@ -92,6 +92,13 @@ void print_plan(const Job& job, const DryRun& d, int ranks)
     if (Grid(job).on_boundary_plane()) fmt::print("boundary plane: xi = {} (limits from inside)\n", *job.grid[0].fixed);
     fmt::print("tiles: {} of up to {} points for {} rank{}\n", d.tiling.tiles(), d.tiling.box(0).points(), ranks,
                ranks == 1 ? "" : "s");
+    if (job.compression == 0) {
+        fmt::print("writers: every rank (uncompressed)\n");
+    } else if (d.writers == 0) {
+        fmt::print("writers: auto (one per node from 64 ranks on, else rank 0 alone)\n");
+    } else {
+        fmt::print("writers: {} (rank 0 and node leaders, at most one per node)\n", d.writers);
+    }
     if (d.plan) {
         const char* mode = d.plan->mode == PlanMode::fresh ? "new run" : d.plan->mode == PlanMode::resume ? "resume" : "complete";
         fmt::print("plan: {}{}{}\n", mode, d.plan->note.empty() ? "" : ": ", d.plan->note);
@@ -125,6 +132,7 @@ int explore_command(const ExploreOptions& opt)
         const Job job = load_job(opt.job);
         ExploreSettings settings{opt.output, opt.resume, opt.overwrite, kernel.count};
         settings.node_ranks = opt.node_ranks;
+        if (!opt.writers.empty()) settings.writers = writers_from_text(opt.writers, "--writers");
         if (opt.dry_run) {
             if (root) print_plan(job, dry_run_explore(job, settings, world.size()), world.size());
             return 0;

@@ -19,6 +19,7 @@ struct ExploreOptions {
     int node_ranks = 0;      // 0: the ranks sharing memory form a node
     double stop_after = -1;  // seconds of computing, then a clean stop; < 0: none
     std::string kernel;      // empty: $SUPERBALL_KERNEL, else the best variant
+    std::string writers;     // "auto" or a count; empty: the job's [run] writers
 };
 
 int explore_command(const ExploreOptions& opt);

@@ -196,6 +196,11 @@ Runner add_explore_command(CLI::App& app)
                     "schedule as if every N consecutive ranks were a node (default: the ranks sharing memory): "
                     "the cluster's two-level schedule on one machine, for tests")
         ->check(CLI::Range(1, std::numeric_limits<int>::max()));
+    sub->add_option("--writers", opt->writers,
+                    "processes that write the compressed result: a count (rank 0 and node leaders, at most one per "
+                    "node, spread evenly; each writes its share of the nodes' tiles into stripes of [run] alignment "
+                    "that rank 0 grants it) or auto (one per node from 64 ranks on, else rank 0 alone); default: "
+                    "the job's [run] writers, else auto");
     sub->add_flag("--dry-run", opt->dry_run, "check the job and print the plan (grid, tiles, output) without running");
     return [opt] { return explore_command(*opt); };
 }

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 #include "hdf5.hpp"
 #include "layout.hpp"
@@ -269,33 +271,104 @@ TileBatch TileBatch::unpack(std::span<const std::byte> message)
 // ------------------------------------------------------------------------ ChunkAppender
 
 ChunkAppender::ChunkAppender(PartialFile& file, std::uint64_t start, std::uint64_t buffer_bytes)
-    : file_(file), capacity_(buffer_bytes), end_(start)
+    : file_(file), capacity_(buffer_bytes), alone_(true)
+{
+    space_.push_back({start, std::numeric_limits<std::uint64_t>::max()});
+}
+
+ChunkAppender::ChunkAppender(PartialFile& file, Granted space, std::uint64_t buffer_bytes)
+    : file_(file), capacity_(buffer_bytes), alone_(false), ahead_(space.ahead)
 {
 }
 
 void ChunkAppender::add(const TileBatch& batch)
 {
-    Buffer* b = &buffers_[current_];
-    if (!b->bytes.empty() && b->bytes.size() + batch.data.size() > capacity_) {
-        issue();
-        b = &buffers_[current_];
+    // A batch that would take the buffer past its size first sends the buffer off (a single
+    // batch larger than that is written whole).
+    const Buffer& b = buffers_[current_];
+    if (!b.bytes.empty() && b.bytes.size() + batch.data.size() > capacity_) issue();
+    place_all(&batch);
+}
+
+void ChunkAppender::grant(std::uint64_t address, std::uint64_t bytes)
+{
+    if (alone_) throw std::logic_error("ChunkAppender: file space granted to the only writer");
+    if (!space_.empty() && space_.back().end == address) {
+        space_.back().end += bytes;  // the next stripes: one range, nothing skipped between
+    } else {
+        space_.push_back({address, address + bytes});
     }
-    if (b->bytes.empty()) b->at = end_;
-    std::size_t at = 0;
-    for (std::size_t i = 0; i < batch.tiles(); ++i) {
-        const std::uint64_t* e = batch.entries.data() + TileBatch::words * i;
-        b->tiles.push_back({e[0], e[1], {end_ + at, e[2], e[3]}});
-        at += e[2] + e[3];
+    place_all(nullptr);
+}
+
+std::size_t ChunkAppender::place(const TileBatch& batch, std::size_t next, std::size_t& data_at)
+{
+    const auto size = [&](std::size_t i) { return batch.entries[TileBatch::words * i + 2] + batch.entries[TileBatch::words * i + 3]; };
+    while (next < batch.tiles()) {
+        while (!space_.empty() && space_.front().end - space_.front().at < size(next)) {
+            skipped_ += space_.front().end - space_.front().at;
+            space_.pop_front();
+        }
+        if (space_.empty()) break;
+        Range& r = space_.front();
+        // One write is one run of the file: a range apart from the buffer's starts another.
+        if (const Buffer& b = buffers_[current_]; !b.bytes.empty() && b.at + b.bytes.size() != r.at) issue();
+        Buffer& b = buffers_[current_];
+        if (b.bytes.empty()) b.at = r.at;
+        std::uint64_t bytes = 0;
+        for (; next < batch.tiles() && bytes + size(next) <= r.end - r.at; ++next) {
+            const std::uint64_t* e = batch.entries.data() + TileBatch::words * next;
+            b.tiles.push_back({e[0], e[1], {r.at + bytes, e[2], e[3]}});
+            bytes += size(next);
+        }
+        const auto from = batch.data.begin() + static_cast<std::ptrdiff_t>(data_at);
+        b.bytes.insert(b.bytes.end(), from, from + static_cast<std::ptrdiff_t>(bytes));
+        r.at += bytes;
+        data_at += bytes;
     }
-    b->bytes.insert(b->bytes.end(), batch.data.begin(), batch.data.end());
-    end_ += batch.data.size();
+    return next;
+}
+
+void ChunkAppender::place_all(const TileBatch* batch)
+{
+    if (waiting_next_ < waiting_.tiles()) {
+        const std::size_t at = waiting_at_;
+        waiting_next_ = place(waiting_, waiting_next_, waiting_at_);
+        waiting_bytes_ -= waiting_at_ - at;
+        if (waiting_next_ == waiting_.tiles()) {
+            waiting_.clear();
+            waiting_next_ = waiting_at_ = 0;
+        }
+    }
+    if (batch) {
+        // Straight from the batch while nothing waits before it (no copy); what finds no
+        // space waits, in order.
+        std::size_t next = 0, at = 0;
+        if (waiting_.empty()) next = place(*batch, 0, at);
+        for (std::size_t i = next; i < batch->tiles(); ++i) {
+            const auto* e = batch->entries.data() + TileBatch::words * i;
+            waiting_.entries.insert(waiting_.entries.end(), e, e + TileBatch::words);
+        }
+        waiting_.data.insert(waiting_.data.end(), batch->data.begin() + static_cast<std::ptrdiff_t>(at), batch->data.end());
+        waiting_bytes_ += batch->data.size() - at;
+    }
     // Written at once when no write is in progress (the journal lags the counting by
     // little), else gathered until the write in progress is done or the buffer is full.
-    const Buffer& other = buffers_[1 - current_];
-    if (b->bytes.size() >= capacity_ || !other.write.valid() ||
-        other.write.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-        issue();
-    }
+    if (buffers_[current_].bytes.size() >= capacity_ || !in_flight(buffers_[1 - current_])) issue();
+}
+
+std::uint64_t ChunkAppender::wanted(std::uint64_t more) const
+{
+    if (alone_) return 0;
+    std::uint64_t held = 0;
+    for (const Range& r : space_) held += r.end - r.at;
+    const std::uint64_t need = waiting_bytes_ + more + ahead_;
+    return need > held ? need - held : 0;
+}
+
+bool ChunkAppender::in_flight(const Buffer& b) const
+{
+    return b.write.valid() && b.write.wait_for(std::chrono::seconds(0)) != std::future_status::ready;
 }
 
 void ChunkAppender::issue()
@@ -304,7 +377,14 @@ void ChunkAppender::issue()
     if (b.bytes.empty()) return;
     const PosixFile& f = file_.file();
     // A thread per write (a few per second at most): the buffer stays untouched until waited for.
-    b.write = std::async(std::launch::async, [&f, &b] { f.write_at(b.at, b.bytes.data(), b.bytes.size()); });
+    // The bytes on stable storage before their tiles are reported written: a writer's node
+    // that dies (its page cache with it) then cannot take back tiles rank 0 has recorded,
+    // which would make the partial file damaged for the resume. Compressed writes are few:
+    // no measurable cost here (docs/decisions.md).
+    b.write = std::async(std::launch::async, [&f, &b] {
+        f.write_at(b.at, b.bytes.data(), b.bytes.size());
+        f.sync_data();
+    });
     current_ = 1 - current_;
     complete(buffers_[current_]);
 }
@@ -327,17 +407,25 @@ void ChunkAppender::complete(Buffer& b)
 std::vector<AppendedTile> ChunkAppender::written()
 {
     Buffer& other = buffers_[1 - current_];
-    if (other.write.valid() && other.write.wait_for(std::chrono::seconds(0)) == std::future_status::ready) complete(other);
+    if (other.write.valid() && !in_flight(other)) complete(other);
+    if (!other.write.valid()) issue();
     return std::exchange(written_, {});
 }
 
 std::vector<AppendedTile> ChunkAppender::flush()
 {
+    if (waiting_next_ < waiting_.tiles()) throw std::logic_error("ChunkAppender::flush: tiles still wait for file space");
     // At most one buffer is being written, the other one; issue() waits for it before the
     // current buffer's write is waited for, so tiles keep their order.
     issue();
     complete(buffers_[1 - current_]);
     return std::exchange(written_, {});
+}
+
+bool ChunkAppender::holding() const
+{
+    return waiting_next_ < waiting_.tiles() || !written_.empty() ||
+           std::any_of(std::begin(buffers_), std::end(buffers_), [](const Buffer& b) { return !b.bytes.empty(); });
 }
 
 // --------------------------------------------------------------------------- TileWriter

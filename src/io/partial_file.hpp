@@ -22,6 +22,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <future>
 #include <span>
@@ -137,23 +138,46 @@ struct TileBatch {
     static TileBatch unpack(std::span<const std::byte> message);
 };
 
-// Rank 0's writer of compressed tiles: batches are copied into a buffer, written at the
-// end of the file (by a thread of its own, so the copy into the file system overlaps with
-// counting and serving; at once when no write is in progress, else gathered with the
-// next batches) and reported written with their addresses.
+// A writer of compressed tiles (rank 0's, and with several writers each node leader's that
+// writes, run/work_pool.hpp): batches are placed in the file space the writer holds, copied
+// into a buffer and written (by a thread of its own, so the copy into the file system
+// overlaps with counting and serving; at once when no write is in progress, else gathered
+// with the next batches), then reported written with their addresses. The only writer holds
+// the file from its end on; one of several holds the space rank 0 granted it (whole stripes,
+// so that no two writers share one), asks for more ahead of need, and places a tile where
+// it fits whole (a range's end too short for the next tile stays unused).
 class ChunkAppender {
 public:
-    // Appends from byte `start` on (the file's end: nothing there is overwritten).
+    // File space granted by rank 0 to one of several writers: ask for this many bytes more
+    // than the tiles waiting need (a stripe), so that a write rarely waits for a round trip.
+    struct Granted {
+        std::uint64_t ahead = 0;
+    };
+
+    // The only writer: appends from byte `start` on (the file's end: nothing there is
+    // overwritten).
     ChunkAppender(PartialFile& file, std::uint64_t start, std::uint64_t buffer_bytes);
+    // One of several: places tiles only in the space given by grant().
+    ChunkAppender(PartialFile& file, Granted space, std::uint64_t buffer_bytes);
 
     void add(const TileBatch& batch);
-    // The tiles written since the last call (without waiting for writes in progress).
+    // Bytes of file space it needs beyond what it holds to place what waits and `more`
+    // bytes (0: none; always 0 alone).
+    std::uint64_t wanted(std::uint64_t more = 0) const;
+    // [address, address + bytes) is this writer's (rank 0 granted it).
+    void grant(std::uint64_t address, std::uint64_t bytes);
+    // The tiles written since the last call (without waiting for writes in progress); starts
+    // writing what waits when no write is in progress.
     std::vector<AppendedTile> written();
     // Writes what is buffered and waits for every write; the tiles written since the
-    // last call.
+    // last call. std::logic_error if a tile still waits for file space.
     std::vector<AppendedTile> flush();
-    // The next tile's address: the end of the data.
-    std::uint64_t end() const { return end_; }
+    // Some tile added has not been returned written yet.
+    bool holding() const;
+    // The next tile's address alone: the end of the data.
+    std::uint64_t end() const { return space_.empty() ? 0 : space_.back().at; }
+    // Bytes of granted space left unused: range ends too short for the next tile.
+    std::uint64_t skipped() const { return skipped_; }
 
 private:
     struct Buffer {
@@ -162,12 +186,27 @@ private:
         std::vector<AppendedTile> tiles;
         std::future<void> write;  // valid while being written
     };
+    struct Range {
+        std::uint64_t at = 0, end = 0;  // unused space [at, end)
+    };
+    // Places `batch`'s tiles from `next` on (their data from `data_at`) in the space held, in
+    // runs that each go to one buffer; returns the first tile that found no space.
+    std::size_t place(const TileBatch& batch, std::size_t next, std::size_t& data_at);
+    // Places what waits for space, then `batch` (or keeps it waiting), and writes as add() says.
+    void place_all(const TileBatch* batch);
     void issue();
     void complete(Buffer& b);
+    bool in_flight(const Buffer& b) const;
 
     PartialFile& file_;
     std::uint64_t capacity_;
-    std::uint64_t end_;
+    bool alone_;
+    std::uint64_t ahead_ = 0;
+    std::deque<Range> space_;
+    TileBatch waiting_;  // tiles with no space yet, from waiting_next_ (data from waiting_at_)
+    std::size_t waiting_next_ = 0, waiting_at_ = 0;
+    std::uint64_t waiting_bytes_ = 0;
+    std::uint64_t skipped_ = 0;
     Buffer buffers_[2];
     int current_ = 0;
     std::vector<AppendedTile> written_;

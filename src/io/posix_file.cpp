@@ -50,6 +50,13 @@ void PosixFile::write_at(std::uint64_t offset, const void* data, std::size_t byt
     }
 }
 
+void PosixFile::sync_data() const
+{
+    while (::fdatasync(fd_) != 0) {
+        if (errno != EINTR) fail("fdatasync");
+    }
+}
+
 std::uint64_t PosixFile::size() const
 {
     struct stat st {};

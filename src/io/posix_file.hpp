@@ -29,6 +29,9 @@ public:
     // interrupted calls); std::system_error on failure (ENOSPC for a full disk).
     void write_at(std::uint64_t offset, const void* data, std::size_t bytes) const;
     void read_at(std::uint64_t offset, void* data, std::size_t bytes) const;
+    // The file's data written so far on stable storage (fdatasync): what a node's crash
+    // cannot take back. std::system_error on failure.
+    void sync_data() const;
     // The file's size in bytes.
     std::uint64_t size() const;
     // Closes now, reporting failure (the destructor cannot).

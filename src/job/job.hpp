@@ -77,6 +77,10 @@ struct Job {
     // [run] checkpoint_seconds: rank 0 records the finished tiles (the resume journal) at
     // most this often, and when the run ends or stops.
     double checkpoint_seconds = 10.0;
+    // [run] writers: the processes that write compressed tiles, rank 0 and node leaders (at
+    // most one per node; run/work_pool.hpp); 0 ("auto"): one per node from 64 ranks on,
+    // else rank 0 alone.
+    std::uint32_t writers = 0;
     std::string text;                     // the job file's text, stored in results
 
     // The range axes, in result order: swept parameters, then coordinates (1 to 4 in all).
@@ -86,6 +90,12 @@ struct Job {
     // Number of grid points (product of the range sizes).
     std::uint64_t points() const;
 };
+
+// The most writers a job may ask for ([run] writers, explore --writers).
+inline constexpr std::uint32_t max_writers = 65536;
+// "auto" (0) or a count of writers from 1 to max_writers, as written after `key` (the
+// flag or key named by the InputError otherwise).
+std::uint32_t writers_from_text(std::string_view text, std::string_view key);
 
 // Parses and validates a job. `source` names the text in messages (usually the path).
 // Throws InputError naming the key, the value and what is accepted.

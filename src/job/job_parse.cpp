@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -37,9 +38,11 @@ const std::vector<std::string> top_level_keys = {"model", "grid", "run"};
 const std::vector<std::string> model_keys = {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "g", "radius"};
 const std::vector<std::string> range_keys = {"min", "max", "n"};
 const std::vector<std::string> run_keys = {"max_bounces", "output",      "tile_points", "refine",
-                                           "compression", "alignment", "checkpoint_seconds"};
+                                           "compression", "alignment", "checkpoint_seconds", "writers"};
 
 [[noreturn]] void fail(const std::string& message) { throw InputError(message); }
+
+const std::string writers_accepted = "\"auto\" or a count of writers from 1 to " + std::to_string(max_writers);
 
 std::vector<std::string> grid_keys(Coordinates c)
 {
@@ -461,6 +464,13 @@ void parse_run(const toml::table* run, Job& job)
         }
         job.checkpoint_seconds = c;
     }
+    if (const toml::node* n = run->get("writers")) {
+        if (const auto* text = n->as_string()) {
+            job.writers = writers_from_text(text->get(), "[run] writers");
+        } else {
+            job.writers = static_cast<std::uint32_t>(integer_in(*n, "[run] writers", 1, max_writers, writers_accepted));
+        }
+    }
 }
 
 Job validate(const toml::table& root)
@@ -487,6 +497,17 @@ std::string syntax_error_message(std::string_view source, const toml::parse_erro
 }
 
 }  // namespace
+
+std::uint32_t writers_from_text(std::string_view text, std::string_view key)
+{
+    if (text == "auto") return 0;
+    std::uint32_t n = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+    if (ec != std::errc{} || end != text.data() + text.size() || n < 1 || n > max_writers) {
+        fail(std::string(key) + " = \"" + std::string(text) + "\" is not accepted: accepted " + writers_accepted);
+    }
+    return n;
+}
 
 Job parse_job(std::string_view text, std::string_view source)
 {

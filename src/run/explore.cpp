@@ -384,6 +384,30 @@ double seconds_since(std::chrono::steady_clock::time_point t)
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+// Rank 0's append buffer, and a writer's: 8 MiB, or a stripe if larger.
+std::uint64_t append_buffer_bytes(const Job& job) { return std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment); }
+
+// A node leader writing compressed tiles (run/work_pool.hpp, TileSink): its own, its node's
+// and those passed aside to it, into the file space rank 0 grants it, a stripe ahead.
+class AppenderSink final : public TileSink {
+public:
+    AppenderSink(PartialFile& file, const Job& job)
+        : appender_(file, ChunkAppender::Granted{job.alignment}, append_buffer_bytes(job))
+    {
+    }
+    void add(std::span<const TileReport> tiles, std::span<const std::byte> payload) override
+    {
+        appender_.add(batch_of(tiles, payload));
+    }
+    std::uint64_t wanted() const override { return appender_.wanted(); }
+    void grant(std::uint64_t address, std::uint64_t bytes) override { appender_.grant(address, bytes); }
+    std::vector<AppendedTile> written() override { return appender_.written(); }
+    bool holding() const override { return appender_.holding(); }
+
+private:
+    ChunkAppender appender_;
+};
+
 }  // namespace
 
 std::unique_ptr<ExploreWork> make_explore_work(const Job& job, const Grid& grid, const Tiling& tiling,
@@ -405,12 +429,41 @@ fs::path output_path(const Job& job, const ExploreSettings& settings)
     return out;
 }
 
+TileBatch batch_of(std::span<const TileReport> tiles, std::span<const std::byte> payload)
+{
+    TileBatch batch = TileBatch::unpack(payload);
+    const std::vector<TileReport> carried = batch.reports();
+    if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
+            return a.tile == b.tile && a.checksum == b.checksum;
+        })) {
+        throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
+    }
+    return batch;
+}
+
 Recorder::Recorder(PartialFile& file, const fs::path& partial, TileJournal journal, const Job& job,
-                   const PartialLayout& layout, const Tiling& tiling, RunObserver& observer)
+                   const PartialLayout& layout, const Tiling& tiling, RunObserver& observer, int writers)
     : partial_(partial), tiling_(tiling), observer_(observer),
       record_(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds))
 {
-    if (layout.compressed) appender_.emplace(file, file.file().size(), std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment));
+    if (!layout.compressed) return;
+    // Alone, the tiles follow one another from the file's end exactly as they come; with
+    // several writers every grant is whole stripes, rank 0's own asked a stripe ahead like
+    // the others'.
+    if (writers <= 1) {
+        appender_.emplace(file, file.file().size(), append_buffer_bytes(job));
+        return;
+    }
+    unit_ = job.alignment;
+    next_free_ = (file.file().size() + unit_ - 1) / unit_ * unit_;
+    appender_.emplace(file, ChunkAppender::Granted{unit_}, append_buffer_bytes(job));
+}
+
+FileSpace Recorder::grant(std::uint64_t bytes)
+{
+    const FileSpace f{next_free_, (bytes + unit_ - 1) / unit_ * unit_};
+    next_free_ += f.bytes;
+    return f;
 }
 
 template <class Tile>
@@ -424,19 +477,27 @@ void Recorder::tell(std::span<const Tile> tiles)
 void Recorder::done(std::span<const TileReport> tiles, std::span<const std::byte> payload)
 {
     if (appender_) {
-        const TileBatch batch = TileBatch::unpack(payload);
-        const std::vector<TileReport> carried = batch.reports();
-        if (carried.size() != tiles.size() || !std::equal(carried.begin(), carried.end(), tiles.begin(), [](auto& a, auto& b) {
-                return a.tile == b.tile && a.checksum == b.checksum;
-            })) {
-            throw std::logic_error("explore: the tiles a rank sent differ from those it reported");
-        }
+        // Rank 0 grants itself its file space first (several writers), so that the batch is
+        // placed as it comes.
+        const TileBatch batch = batch_of(tiles, payload);
+        const auto grant_own = [&](std::uint64_t bytes) {
+            const FileSpace f = grant(bytes);
+            appender_->grant(f.address, f.bytes);
+        };
+        if (const std::uint64_t w = appender_->wanted(batch.data.size())) grant_own(w);
         appender_->add(batch);
+        while (const std::uint64_t w = appender_->wanted()) grant_own(w);  // range ends too short for a tile
         recorded(appender_->written());
     } else {
         record_.record(tiles);
         tell(tiles);
     }
+    if (record_.due()) checkpoint();
+}
+
+void Recorder::placed(std::span<const AppendedTile> tiles)
+{
+    recorded(tiles);
     if (record_.due()) checkpoint();
 }
 
@@ -576,6 +637,25 @@ TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& p
     return left;
 }
 
+// What the run's note says of its writers when they are not what was asked: `asked` (0:
+// auto) for a compressed file, `writers` chosen.
+std::string writers_note(int asked, int writers, const PartialLayout& layout)
+{
+    if (!layout.compressed && asked > 1) {
+        return "every rank writes its own tiles to an uncompressed result ([run] compression = 0): writers = " +
+               std::to_string(asked) + " does not apply";
+    }
+    if (asked <= writers) return "";
+    return fmt::format("{} writers asked, {} write{}: writers are rank 0 and node leaders, at most one per node "
+                       "(--node-ranks N makes nodes of N ranks on one machine)",
+                       asked, writers, writers == 1 ? "s" : "");
+}
+
+std::string join_notes(const std::string& a, const std::string& b)
+{
+    return a.empty() ? b : b.empty() ? a : a + "; " + b;
+}
+
 // What rank 0 does with the partial file once the tiles are counted: an interrupted run's
 // seconds recorded in it, a complete run's result made from it. A failure on rank 0 is
 // thrown on every rank.
@@ -650,6 +730,8 @@ ScheduleFigures schedule_figures(const mpi::Comm& comm, const ScheduleStats& min
     f.tiles_max = static_cast<std::uint64_t>(most);
     f.tiles_min = static_cast<std::uint64_t>(fewest);
     f.max_leader_messages = static_cast<std::uint64_t>(leader_messages);
+    f.writers = mine.writers;
+    f.placed_max = static_cast<std::uint64_t>(comm.max(static_cast<double>(mine.tiles_placed)));
     return f;
 }
 
@@ -658,7 +740,8 @@ ScheduleFigures schedule_figures(const mpi::Comm& comm, const ScheduleStats& min
 DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks)
 {
     const fs::path out = output_path(job, settings);
-    DryRun d{std::nullopt, {}, out, layout::partial_path(out), default_tiling(job, ranks), false, false, std::nullopt};
+    DryRun d{std::nullopt, {}, out, layout::partial_path(out), default_tiling(job, ranks), false, false, std::nullopt,
+             settings.writers.value_or(job.writers)};
     const Decision decision = decide_or_refuse(settings, out, job);
     if (decision.verdict == Verdict::refuse) {
         d.refusal = decision.message;
@@ -705,13 +788,27 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const Tiling tiling(grid.shape(), start.tile_shape);
     PartialFile file(partial, comm, tiling, layout);
     TilesLeft left = tiles_left(comm, file, partial, plan.mode, start.journal, layout, tiling);
+    ScheduleSettings schedule;
+    schedule.node_ranks = settings.node_ranks;
+    schedule.writers = static_cast<int>(settings.writers.value_or(job.writers));
+    const int writers = layout.compressed ? schedule_writers(comm, schedule) : 1;
     std::optional<Recorder> recorder;
     if (comm.is_root()) {
-        RunStart run_start{plan.output, plan.note, comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(),
-                           left.done.size(), 0};
+        RunStart run_start{plan.output, join_notes(plan.note, writers_note(schedule.writers, writers, layout)),
+                           comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(), left.done.size(), 0};
         for (const std::uint64_t t : left.done) run_start.points_done += tiling.box(t).points();
         observer.started(run_start);
-        recorder.emplace(file, partial, std::move(start.journal), job, layout, tiling, observer);
+        recorder.emplace(file, partial, std::move(start.journal), job, layout, tiling, observer, writers);
+    }
+    // Several writers: rank 0 records where the others wrote and grants them file space;
+    // each rank but 0 holds a sink, used if the schedule makes it a writer.
+    std::optional<AppenderSink> sink;
+    Writers writing;
+    if (writers > 1 && comm.is_root()) {
+        writing.placed = [&](std::span<const AppendedTile> tiles) { recorder->placed(tiles); };
+        writing.grant = [&](std::uint64_t bytes) { return recorder->grant(bytes); };
+    } else if (writers > 1) {
+        writing.sink = &sink.emplace(file, job);
     }
 
     // Uncompressed tiles: each rank writes its own, in pieces of at least one alignment
@@ -727,15 +824,13 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
         recorder->done(tiles, payload);
     };
-    ScheduleSettings schedule;
-    schedule.node_ranks = settings.node_ranks;
     // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
     // and the granule only groups tiles for the interleaved hand-out.
     schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
     const std::vector<std::uint64_t> pending =
         handout_order(left.pending, schedule.granule, comm.size() >= settings.interleave_ranks);
     const auto compute_start = std::chrono::steady_clock::now();
-    const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule);
+    const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule, writing);
     const auto compute_end = std::chrono::steady_clock::now();
     const double compute_seconds = comm.broadcast(std::chrono::duration<double>(compute_end - compute_start).count());
     if (comm.is_root()) observer.computed(compute_seconds);

@@ -46,6 +46,8 @@ struct ExploreSettings {
     // n > 0, groups of n consecutive ranks (the two-level schedule on one machine, as
     // tests/scale/validate.sh --oversubscribed runs it beside its simulation).
     int node_ranks = 0;
+    // Who writes compressed tiles (Job::writers: 0 auto, else a count): this, else the job's.
+    std::optional<std::uint32_t> writers{};
 };
 
 // The output path a job and settings write to: settings.output, else the job's [run]
@@ -89,6 +91,7 @@ struct DryRun {
         bool same_job = false;
     };
     std::optional<Existing> existing;  // when it exists and reads as a superball file
+    std::uint32_t writers = 0;         // asked for (0: auto)
 };
 DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks);
 
@@ -111,6 +114,8 @@ struct ScheduleFigures {
     std::uint64_t root_asked_back = 0;     // requests for tiles back rank 0 sent
     std::uint64_t max_leader_messages = 0; // most messages another rank (a node leader) received
     std::uint64_t given_back = 0;    // tiles given back, every rank
+    int writers = 1;                 // ranks that wrote compressed tiles (rank 0 and node leaders)
+    std::uint64_t placed_max = 0;    // most tiles a writer other than rank 0 wrote
 };
 
 struct RunSummary {

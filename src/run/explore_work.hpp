@@ -48,16 +48,22 @@ StartedPartial start_partial(const std::filesystem::path& partial, PlanMode mode
                              const Provenance& provenance);
 
 // The record of a run, kept by the one process that writes it (rank 0, or
-// run_explore_threads): the tiles done, in the journal, and the compressed ones written
-// (from the end of the file: whatever an interrupted run wrote past its last record stays
-// unused). Every argument must outlive it.
+// run_explore_threads): the tiles done, in the journal, and the compressed ones it writes
+// itself (from the end of the file: whatever an interrupted run wrote past its last record
+// stays unused). With several writers (run/work_pool.hpp) it also records where the others
+// wrote theirs and grants them their file space: whole stripes (`[run] alignment`) past
+// the end, each writer its own, rank 0's share included. Every argument must outlive it.
 class Recorder {
 public:
     Recorder(PartialFile& file, const std::filesystem::path& partial, TileJournal journal, const Job& job,
-             const PartialLayout& layout, const Tiling& tiling, RunObserver& observer);
+             const PartialLayout& layout, const Tiling& tiling, RunObserver& observer, int writers = 1);
 
     // The reports of finished tiles, with their compressed data when this process writes them.
     void done(std::span<const TileReport> tiles, std::span<const std::byte> payload);
+    // Tiles another writer wrote, where they lie.
+    void placed(std::span<const AppendedTile> tiles);
+    // File space for a writer that asks `bytes`.
+    FileSpace grant(std::uint64_t bytes);
     // The journal written, and, for compressed tiles, every tile written so far recorded
     // first and then covered by the file's HDF5 end (PlacedChunks::cover).
     void checkpoint();
@@ -76,8 +82,14 @@ private:
     const Tiling& tiling_;
     RunObserver& observer_;
     Journal record_;
+    std::uint64_t unit_ = 1;       // of file space: a stripe with several writers, else a byte
+    std::uint64_t next_free_ = 0;  // the first byte no writer holds
     std::optional<ChunkAppender> appender_;
 };
+
+// A rank's compressed tiles as a batch: the payload TileWork::flush made, checked against
+// the reports that came with it (std::logic_error if they differ).
+TileBatch batch_of(std::span<const TileReport> tiles, std::span<const std::byte> payload);
 
 // Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
 double peak_rss_mib();

@@ -12,6 +12,8 @@ namespace {
 // tree has a communicator of its own (the node's, the leaders'), so tags never meet.
 constexpr int tag_up = 21;
 constexpr int tag_down = 22;
+// Aside: a node leader to the leader that writes its node's tiles, on the leaders'.
+constexpr int tag_aside = 23;
 
 // Which ranks serve which: the node (every rank of `comm` when one level is enough) and
 // the node leaders, rank 0 first.
@@ -19,6 +21,7 @@ struct Topology {
     mpi::OwnedComm node;
     mpi::OwnedComm leaders;  // null on ranks that lead no node
     bool two_level = false;
+    int nodes = 1;
 };
 
 Topology make_topology(const mpi::Comm& comm, const ScheduleSettings& s)
@@ -33,6 +36,7 @@ Topology make_topology(const mpi::Comm& comm, const ScheduleSettings& s)
     const double biggest = comm.max(static_cast<double>(node.size()));
     // One rank per node gains nothing from a leader: every rank is then served by rank 0.
     t.two_level = nodes > 1 && biggest > 1;
+    t.nodes = t.two_level ? static_cast<int>(nodes) : 1;
     if (!t.two_level) t.node = mpi::OwnedComm::dup(comm);
     t.leaders = mpi::OwnedComm::split(comm, t.node.view().rank() == 0 ? 0 : MPI_UNDEFINED, rank);
     return t;
@@ -47,7 +51,8 @@ PoolPlace place_of(const mpi::Comm& comm, const Topology& t)
     p.two_level = t.two_level;
     p.node_rank = node.rank();
     p.node_size = node.size();
-    p.leaders = t.leaders.get() != MPI_COMM_NULL ? t.leaders.view().size() : 0;
+    p.leaders = t.nodes;
+    p.leader_rank = t.leaders.get() != MPI_COMM_NULL ? t.leaders.view().rank() : 0;
     return p;
 }
 
@@ -79,16 +84,14 @@ public:
 
     std::optional<int> receive_up(Level level, std::vector<std::uint64_t>& words) override
     {
-        const MPI_Comm comm = level == Level::node ? node_ : leaders_;
-        int waiting = 0;
-        MPI_Status st;
-        mpi::check(MPI_Iprobe(MPI_ANY_SOURCE, tag_up, comm, &waiting, &st), "MPI_Iprobe");
-        if (!waiting) return std::nullopt;
-        int n = 0;
-        mpi::check(MPI_Get_count(&st, MPI_UINT64_T, &n), "MPI_Get_count");
-        words.resize(static_cast<std::size_t>(n));
-        mpi::check(MPI_Recv(words.data(), n, MPI_UINT64_T, st.MPI_SOURCE, tag_up, comm, MPI_STATUS_IGNORE), "MPI_Recv");
-        return st.MPI_SOURCE;
+        return receive_any(tag_up, level == Level::node ? node_ : leaders_, words);
+    }
+
+    void send_aside(int leader, std::span<const std::uint64_t> words) override { send(words, leader, tag_aside, leaders_); }
+
+    bool receive_aside(std::vector<std::uint64_t>& words) override
+    {
+        return leaders_ != MPI_COMM_NULL && receive_any(tag_aside, leaders_, words).has_value();
     }
 
     bool receive_down(std::span<std::uint64_t> words, bool wait) override
@@ -105,6 +108,20 @@ public:
     }
 
 private:
+    // The next message with `tag` on `comm`, whatever its size, and its sender.
+    static std::optional<int> receive_any(int tag, MPI_Comm comm, std::vector<std::uint64_t>& words)
+    {
+        int waiting = 0;
+        MPI_Status st;
+        mpi::check(MPI_Iprobe(MPI_ANY_SOURCE, tag, comm, &waiting, &st), "MPI_Iprobe");
+        if (!waiting) return std::nullopt;
+        int n = 0;
+        mpi::check(MPI_Get_count(&st, MPI_UINT64_T, &n), "MPI_Get_count");
+        words.resize(static_cast<std::size_t>(n));
+        mpi::check(MPI_Recv(words.data(), n, MPI_UINT64_T, st.MPI_SOURCE, tag, comm, MPI_STATUS_IGNORE), "MPI_Recv");
+        return st.MPI_SOURCE;
+    }
+
     static void send(std::span<const std::uint64_t> words, int to, int tag, MPI_Comm comm)
     {
         mpi::check(MPI_Send(words.data(), static_cast<int>(words.size()), MPI_UINT64_T, to, tag, comm), "MPI_Send");
@@ -118,13 +135,19 @@ private:
 }  // namespace
 
 ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work,
-                            const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings)
+                            const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings,
+                            const Writers& writers)
 {
     const Topology topo = make_topology(comm, settings);
     MpiLinks links(topo, comm.is_root());
-    PoolResult r = run_pool(links, place_of(comm, topo), pending, work, done, stop, settings);
+    PoolResult r = run_pool(links, place_of(comm, topo), pending, work, done, stop, settings, writers);
     const std::int64_t interrupted = comm.is_root() && r.unfinished ? 1 : 0;
     return {comm.broadcast(interrupted) != 0, std::move(r.stats)};
+}
+
+int schedule_writers(const mpi::Comm& comm, const ScheduleSettings& settings)
+{
+    return writer_count(place_of(comm, make_topology(comm, settings)), settings);
 }
 
 }  // namespace superball

@@ -17,8 +17,14 @@ struct ScheduleResult {
 };
 
 // Collective over `comm`. `pending` (identical on every rank): the tiles to compute, in
-// the order they are handed out; consecutive entries form the blocks.
+// the order they are handed out; consecutive entries form the blocks. `writers`: every rank
+// gives a sink or none does.
 ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work,
-                            const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings = {});
+                            const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings = {},
+                            const Writers& writers = {});
+
+// Collective over `comm`: how many ranks run_schedule with these settings (and Writers)
+// makes writers of compressed tiles.
+int schedule_writers(const mpi::Comm& comm, const ScheduleSettings& settings);
 
 }  // namespace superball

@@ -5,28 +5,86 @@
 #include <cstring>
 #include <deque>
 #include <stdexcept>
+#include <utility>
 
 namespace superball {
 
 namespace {
 
-// Up message: {flags, weight, unstarted, received, idle, groups, per group: rank, n, n
-// (tile, checksum) pairs, payload bytes b, the payload in ceil(b / 8) words; ranges, then
-// (first, count) per range}. The weight is the number
-// of computing ranks the sender speaks for (1, or a node); unstarted, the most unstarted
-// tiles one rank holds, of the sender and the ranks it serves (what asking it for tiles
-// back can split; a node of many ranks with one tile each has nothing to give); received, the tiles its server has assigned
-// it so far (so the server can add those still on their way); idle, how many of those
-// ranks have nothing to compute; the ranges, tiles it gives back.
+// Up message: {flags, weight, unstarted, received, idle, want, groups, the groups; ranges,
+// then (first, count) per range}. The weight is the number of computing ranks the sender
+// speaks for (1, or a node); unstarted, the most unstarted tiles one rank holds, of the
+// sender and the ranks it serves (what asking it for tiles back can split; a node of many
+// ranks with one tile each has nothing to give); received, the tiles its server has
+// assigned it so far (so the server can add those still on their way); idle, how many of
+// those ranks have nothing to compute; want, the bytes of file space a writer asks rank 0
+// for (0: none); the ranges, tiles it gives back.
+// A group: {rank, kind, n, n entries, ...}. Reported: entries (tile, checksum), then
+// payload bytes b and the payload in ceil(b / 8) words. Placed (by a writer other than
+// rank 0): entries (tile, checksum, address, counts bytes, outcomes bytes).
+// Aside message (a leader to the leader that writes for it): {last, groups, the groups}.
 constexpr std::uint64_t want_block = 1;     // asks for the next block
 constexpr std::uint64_t final_message = 2;  // the sender is done: no message follows
 constexpr std::uint64_t stopping = 4;       // the sender saw a stop: stop everyone
 constexpr std::uint64_t gift = 8;           // answers give_back (with no range: none to give)
+constexpr std::size_t up_header = 7;
+enum class Group : std::uint64_t { reported = 0, placed = 1 };
+constexpr std::uint64_t placed_words = 5;
 // Down message: {kind, first, count, tiles the sender has left to hand out}.
 // give_back: every unstarted tile but the next; give_one: the next too, from a rank in the
-// middle of a tile (the end of a run, see PoolRank::rebalance).
-enum class Down : std::uint64_t { assign = 1, end = 2, stop = 3, bye = 4, give_back = 5, give_one = 6 };
+// middle of a tile (the end of a run, see PoolRank::rebalance); space: file space for a
+// writer (first: its address, count: its bytes).
+enum class Down : std::uint64_t { assign = 1, end = 2, stop = 3, bye = 4, give_back = 5, give_one = 6, space = 7 };
 constexpr std::size_t down_words = 4;
+
+// A group of an up or aside message, read in place.
+struct GroupView {
+    std::uint64_t rank = 0;
+    Group kind = Group::reported;
+    std::uint64_t n = 0;
+    const std::uint64_t* entries = nullptr;
+    std::span<const std::byte> payload;  // reported groups
+    std::size_t words = 0;               // of the whole group
+
+    static GroupView at(std::span<const std::uint64_t> msg, std::size_t i)
+    {
+        GroupView g;
+        g.rank = msg[i];
+        g.kind = static_cast<Group>(msg[i + 1]);
+        g.n = msg[i + 2];
+        g.entries = msg.data() + i + 3;
+        if (g.kind == Group::placed) {
+            g.words = 3 + placed_words * g.n;
+            return g;
+        }
+        const std::uint64_t bytes = msg[i + 3 + 2 * g.n];
+        g.payload = {reinterpret_cast<const std::byte*>(msg.data() + i + 4 + 2 * g.n), bytes};
+        g.words = 4 + 2 * g.n + (bytes + 7) / 8;
+        return g;
+    }
+    std::vector<TileReport> reports() const
+    {
+        std::vector<TileReport> r(n);
+        for (std::uint64_t k = 0; k < n; ++k) r[k] = {entries[2 * k], entries[2 * k + 1]};
+        return r;
+    }
+    std::vector<AppendedTile> placed() const
+    {
+        std::vector<AppendedTile> p(n);
+        for (std::uint64_t k = 0; k < n; ++k) {
+            const std::uint64_t* e = entries + placed_words * k;
+            p[k] = {e[0], e[1], {e[2], e[3], e[4]}};
+        }
+        return p;
+    }
+};
+
+// Writer w's place among L leaders when W write: the first leader of its share.
+int first_of_share(int share, int leaders, int writers)
+{
+    return static_cast<int>((std::int64_t{share} * leaders + writers - 1) / writers);
+}
+int share_of(int leader, int leaders, int writers) { return static_cast<int>(std::int64_t{leader} * writers / leaders); }
 
 struct Range {
     std::uint64_t first = 0;
@@ -75,8 +133,8 @@ std::uint64_t aligned_block(Range r, std::uint64_t n, std::uint64_t granule)
 class PoolRank {
 public:
     PoolRank(PoolLinks& links, const PoolPlace& place, std::span<const std::uint64_t> pending, TileWork& work,
-              const TilesDone& done, const StopRequested& stop, const ScheduleSettings& s)
-        : links_(links), pending_(pending), work_(work), done_(done), stop_(stop), settings_(s)
+              const TilesDone& done, const StopRequested& stop, const ScheduleSettings& s, const Writers& writers)
+        : links_(links), pending_(pending), work_(work), done_(done), stop_(stop), settings_(s), writers_(writers)
     {
         const int ranks = place.ranks;
         world_rank_ = place.rank;
@@ -89,6 +147,7 @@ public:
         stats.two_level = place.two_level;
         stats.leader = leader_;
         stats.computed = computes_;
+        place_writers(place);
 
         if (root_) {
             if (!pending.empty()) pool_.push_back({0, pending.size()});
@@ -144,6 +203,27 @@ public:
     ScheduleStats stats;
 
 private:
+    // Who writes what: a leader writes, passes its node's tiles aside to the leader that
+    // writes for it, or passes them up (to rank 0, which writes for the first share).
+    void place_writers(const PoolPlace& place)
+    {
+        const int count = writers_.sink || writers_.grant ? writer_count(place, settings_) : 1;
+        stats.writers = count;
+        stats.writer = root_;
+        if (count <= 1 || !leader_ || root_) return;
+        const int me = place.leader_rank;
+        const int share = share_of(me, place.leaders, count);
+        const int writer = first_of_share(share, place.leaders, count);
+        if (writer != me) {
+            if (writer != 0) aside_to_ = writer;
+            return;
+        }
+        sink_ = writers_.sink;
+        stats.writer = true;
+        const int next = share + 1 < count ? first_of_share(share + 1, place.leaders, count) : place.leaders;
+        aside_sources_ = next - me - 1;
+    }
+
     struct Child {
         Peer peer;
         std::uint64_t weight = 1;
@@ -310,14 +390,92 @@ private:
             record(f.reports, world_rank_, f.payload);
             return;
         }
-        outbox_.insert(outbox_.end(), {static_cast<std::uint64_t>(world_rank_), f.reports.size()});
-        for (const TileReport& r : f.reports) outbox_.insert(outbox_.end(), {r.tile, r.checksum});
-        outbox_.push_back(f.payload.size());
-        const std::size_t at = outbox_.size();
-        outbox_.resize(at + (f.payload.size() + 7) / 8, 0);
-        if (!f.payload.empty()) std::memcpy(outbox_.data() + at, f.payload.data(), f.payload.size());
         stats.payload_bytes_out += f.payload.size();
+        if (sink_) {
+            sink_->add(f.reports, f.payload);
+            tend_sink();
+            return;
+        }
+        std::vector<std::uint64_t>& box = aside_to_ >= 0 && !f.payload.empty() ? aside_ : outbox_;
+        box.insert(box.end(), {static_cast<std::uint64_t>(world_rank_), static_cast<std::uint64_t>(Group::reported),
+                               f.reports.size()});
+        for (const TileReport& r : f.reports) box.insert(box.end(), {r.tile, r.checksum});
+        box.push_back(f.payload.size());
+        const std::size_t at = box.size();
+        box.resize(at + (f.payload.size() + 7) / 8, 0);
+        if (!f.payload.empty()) std::memcpy(box.data() + at, f.payload.data(), f.payload.size());
+        ++(&box == &aside_ ? aside_groups_ : outbox_groups_);
+    }
+
+    // A group of reported tiles from a rank this one serves (or, aside, from another
+    // leader): written here, passed aside, or passed up.
+    void route(std::span<const std::uint64_t> msg, std::size_t at, const GroupView& g)
+    {
+        const auto words = msg.subspan(at, g.words);
+        if (g.kind == Group::reported && !g.payload.empty() && sink_) {
+            sink_->add(g.reports(), g.payload);
+            tend_sink();
+        } else if (g.kind == Group::reported && !g.payload.empty() && aside_to_ >= 0) {
+            aside_.insert(aside_.end(), words.begin(), words.end());
+            ++aside_groups_;
+        } else {
+            outbox_.insert(outbox_.end(), words.begin(), words.end());
+            ++outbox_groups_;
+        }
+    }
+
+    // A writer's sink: file space asked for ahead (one request at a time), and the tiles it
+    // wrote passed up to rank 0 in place of their data.
+    void tend_sink()
+    {
+        if (!sink_) return;
+        if (!space_asked_) {
+            if (const std::uint64_t w = sink_->wanted(); w > 0) {
+                space_asked_ = true;
+                want_ = w;
+                ++stats.grants;
+                send_up(0);
+            }
+        }
+        const std::vector<AppendedTile> placed = sink_->written();
+        if (placed.empty()) return;
+        outbox_.insert(outbox_.end(), {static_cast<std::uint64_t>(world_rank_), static_cast<std::uint64_t>(Group::placed),
+                                       placed.size()});
+        for (const AppendedTile& t : placed) {
+            outbox_.insert(outbox_.end(),
+                           {t.tile, t.checksum, t.stored.address, t.stored.counts_bytes, t.stored.outcomes_bytes});
+        }
         ++outbox_groups_;
+        stats.tiles_placed += placed.size();
+    }
+
+    void send_aside(bool last)
+    {
+        if (aside_to_ < 0 || (aside_groups_ == 0 && !last)) return;
+        std::vector<std::uint64_t> msg{last ? 1u : 0u, aside_groups_};
+        msg.insert(msg.end(), aside_.begin(), aside_.end());
+        aside_.clear();
+        aside_groups_ = 0;
+        next_aside_ = links_.now() + settings_.report_seconds / 2;
+        links_.send_aside(aside_to_, msg);
+    }
+
+    bool drain_aside()
+    {
+        bool any = false;
+        std::vector<std::uint64_t> msg;
+        while (links_.receive_aside(msg)) {
+            any = true;
+            if (!sink_) throw std::logic_error("schedule: tiles passed aside to a leader that does not write");
+            std::size_t at = 2;
+            for (std::uint64_t g = 0; g < msg[1]; ++g) {
+                const GroupView v = GroupView::at(msg, at);
+                route(msg, at, v);
+                at += v.words;
+            }
+            if (msg[0] != 0) --aside_sources_;
+        }
+        return any;
     }
 
     // A rank that only computes sends its reports at once; a node leader gathers its
@@ -325,6 +483,7 @@ private:
     // period whatever the node's size.
     void send_reports_if_due()
     {
+        if (aside_groups_ > 0 && (links_.now() >= next_aside_ || aside_.size() >= forward_words)) send_aside(false);
         if (outbox_groups_ == 0 || root_) return;
         // A leader also passes them on once they hold more than a few MiB of data (its node's
         // compressed tiles), so that its memory stays bounded.
@@ -342,7 +501,7 @@ private:
     {
         sent_idle_ = idle_ranks();
         std::vector<std::uint64_t> msg{flags, children_.empty() ? 1 : node_computing_ranks_, unstarted(), received_,
-                                       sent_idle_, outbox_groups_};
+                                       sent_idle_, std::exchange(want_, 0), outbox_groups_};
         msg.insert(msg.end(), outbox_.begin(), outbox_.end());
         msg.push_back(given.size());
         for (const Range& r : given) msg.insert(msg.end(), {r.first, r.count});
@@ -386,6 +545,10 @@ private:
                 any = true;
             }
         }
+        if (sink_) {
+            any |= drain_aside();
+            tend_sink();
+        }
         send_reports_if_due();
         return any;
     }
@@ -409,24 +572,28 @@ private:
         c.unstarted = msg[2];
         c.in_flight = c.assigned - msg[3];
         c.idle = msg[4];
-        const std::uint64_t groups = msg[5];
-        std::size_t at = 6;
+        const std::uint64_t want = msg[5];
+        const std::uint64_t groups = msg[6];
+        std::size_t at = up_header;
         for (std::uint64_t g = 0; g < groups; ++g) {
-            const std::uint64_t rank = msg[at];
-            const std::uint64_t n = msg[at + 1];
-            const std::uint64_t payload_bytes = msg[at + 2 + 2 * n];
-            const std::size_t end = at + 3 + 2 * n + (payload_bytes + 7) / 8;
-            if (root_) {
-                std::vector<TileReport> reports(n);
-                for (std::uint64_t i = 0; i < n; ++i) reports[i] = {msg[at + 2 + 2 * i], msg[at + 3 + 2 * i]};
-                const auto* payload = reinterpret_cast<const std::byte*>(msg.data() + at + 3 + 2 * n);
-                record(reports, static_cast<int>(rank), {payload, payload_bytes});
+            const GroupView v = GroupView::at(msg, at);
+            if (!root_) {
+                route(msg, at, v);
+            } else if (v.kind == Group::placed) {
+                const std::vector<AppendedTile> placed = v.placed();
+                reported_ += placed.size();
+                writers_.placed(placed);
             } else {
-                outbox_.insert(outbox_.end(), msg.begin() + static_cast<std::ptrdiff_t>(at),
-                               msg.begin() + static_cast<std::ptrdiff_t>(end));
-                ++outbox_groups_;
+                record(v.reports(), static_cast<int>(v.rank), v.payload);
             }
-            at = end;
+            at += v.words;
+        }
+        if (want > 0) {
+            // File space for a writer, whatever else goes on (a stopped run still writes
+            // what it counted).
+            const FileSpace f = writers_.grant(want);
+            ++stats.grants;
+            send_down(c, Down::space, {f.address, f.bytes});
         }
         std::vector<Range> given(msg[at]);
         for (std::size_t i = 0; i < given.size(); ++i) given[i] = {msg[at + 1 + 2 * i], msg[at + 2 + 2 * i]};
@@ -517,6 +684,12 @@ private:
             break;
         case Down::give_one:
             give_one();
+            break;
+        case Down::space:
+            if (!sink_) throw std::logic_error("schedule: file space for a rank that does not write");
+            space_asked_ = false;
+            sink_->grant(msg[1], msg[2]);
+            tend_sink();
             break;
         case Down::bye:
             throw std::logic_error("schedule: goodbye from the server before this rank's final message");
@@ -715,7 +888,12 @@ private:
     bool finished() const
     {
         const bool own_done = !computes_ || stopped_ || (current_.count == 0 && pool_tiles_ == 0 && (root_ || parent_end_));
-        return own_done && !owe_back_ && std::none_of(children_.begin(), children_.end(), [](const Child& c) { return c.active; });
+        // A writer goes on until every tile it was given is written and passed up: its own,
+        // its node's, and those of the leaders that pass theirs aside to it (each says when
+        // it has no more).
+        const bool written = !sink_ || (unflushed_ == 0 && aside_sources_ == 0 && !sink_->holding());
+        return own_done && written && !owe_back_ &&
+               std::none_of(children_.begin(), children_.end(), [](const Child& c) { return c.active; });
     }
 
     // Nothing to compute: wait for a message (a plain rank blocks on its server's answer;
@@ -733,7 +911,7 @@ private:
         } clock{links_, since, stats.idle_seconds};
         if (unflushed_ > 0) report_own();  // idle anyway: a good time to write
         send_reports_if_due();
-        if (children_.empty()) {
+        if (children_.empty() && !sink_) {
             if (!outstanding_) throw std::logic_error("schedule: waiting with no request in flight");
             // The request went out ahead, when this rank still had a block: now it has
             // nothing, which its server needs to know to take tiles back for it.
@@ -744,6 +922,9 @@ private:
             return;
         }
         rebalance();
+        // A writer without ranks of its own to serve polls (for its file space and writes)
+        // rather than blocking: it still tells its server when it runs out of work.
+        if (children_.empty() && idle_ && outstanding_ && sent_idle_ == 0) send_up(0);
         if (poll()) {
             idle_pause_ = min_pause;
             return;
@@ -757,6 +938,7 @@ private:
     {
         report_own();
         if (root_) return;
+        send_aside(true);
         send_up(final_message | (stopped_ && !stop_from_parent_ ? stopping : 0));
         std::array<std::uint64_t, down_words> msg{};
         for (;;) {
@@ -780,6 +962,7 @@ private:
     const TilesDone& done_;
     const StopRequested& stop_;
     const ScheduleSettings& settings_;
+    const Writers& writers_;
     int world_rank_ = 0;
     bool root_ = false;
     bool leader_ = false;
@@ -815,16 +998,34 @@ private:
     bool stopped_ = false;
     bool stop_from_parent_ = false;
     std::uint64_t reported_ = 0;  // rank 0: tiles recorded done
+
+    // Writing (place_writers): this rank's sink if it writes for others (rank 0 aside), the
+    // leader it passes its node's tiles to if not (-1: up), the leaders passing theirs here.
+    TileSink* sink_ = nullptr;
+    int aside_to_ = -1;
+    int aside_sources_ = 0;
+    bool space_asked_ = false;        // a request for file space is on its way
+    std::uint64_t want_ = 0;          // file space asked for in the next message up
+    std::vector<std::uint64_t> aside_;  // groups for aside_to_
+    std::uint64_t aside_groups_ = 0;
+    double next_aside_ = 0;
 };
 
 }  // namespace
 
 PoolResult run_pool(PoolLinks& links, const PoolPlace& place, std::span<const std::uint64_t> pending, TileWork& work,
-                    const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings)
+                    const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings, const Writers& writers)
 {
-    PoolRank s(links, place, pending, work, done, stop, settings);
+    PoolRank s(links, place, pending, work, done, stop, settings, writers);
     s.run();
     return {s.interrupted(), std::move(s.stats)};
+}
+
+int writer_count(const PoolPlace& place, const ScheduleSettings& settings)
+{
+    if (!place.two_level || place.leaders < 2) return 1;
+    const int asked = settings.writers > 0 ? settings.writers : place.ranks >= settings.auto_writers_ranks ? place.leaders : 1;
+    return std::clamp(asked, 1, place.leaders);
 }
 
 }  // namespace superball

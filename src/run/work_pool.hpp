@@ -23,11 +23,17 @@
 // - at the end, ranks holding unstarted tiles give them back for the ranks out of work:
 //   within a node through its leader, across nodes through rank 0; once nobody holds two,
 //   a rank in the middle of a tile gives up its next one.
+// Who writes compressed tiles (Writers, ScheduleSettings::writers): rank 0 alone, or rank 0
+// and node leaders. A rank's flushed tiles travel with its reports up the tree to the first
+// writer on the way (its node's leader when that leader writes; a leader that does not
+// passes its node's aside to the leader that writes for it, or up to rank 0); a writer
+// other than rank 0 writes them into file space rank 0 grants it (one round trip, asked
+// ahead) and sends rank 0, in their place, where they lie.
 // Resume: `pending` is what is left to do (job/tiles.hpp, handout_order: interleaved from
 // 64 ranks on, so that a block's cost follows its size); a tile counts as done once rank 0
-// has recorded its report (TilesDone), which comes only after the rank that computed it
-// handed its data over (TileWork::flush). A rank lost mid-run loses at most the tiles it
-// had not flushed: they were never recorded, and the next run's `pending` holds them.
+// has recorded its report (TilesDone, Writers::placed), which comes only after its data were
+// handed over (TileWork::flush) and, with several writers, written. A rank lost mid-run
+// loses at most the tiles not yet recorded: the next run's `pending` holds them.
 #pragma once
 
 #include <cstddef>
@@ -37,6 +43,7 @@
 #include <span>
 #include <vector>
 
+#include "io/stored_tiles.hpp"
 #include "job/tiles.hpp"
 
 namespace superball {
@@ -79,9 +86,46 @@ public:
     virtual bool should_flush() const { return false; }
 };
 
-// Called on rank 0 for finished tiles (see TileWork::flush), with the rank that computed
-// them and the payload that came with them.
+// Called on rank 0 for finished tiles (see TileWork::flush) that reach it unwritten: the
+// uncompressed ones (their rank wrote them) and the compressed ones rank 0 writes (with
+// their payload), with the rank that computed them.
 using TilesDone = std::function<void(std::span<const TileReport> tiles, int rank, std::span<const std::byte> payload)>;
+
+// A writer of compressed tiles other than rank 0 (a node leader, ScheduleSettings::writers):
+// takes the tiles of the ranks it writes for with their payloads (TileWork::flush), writes
+// them into the file space rank 0 grants it, and gives them back placed once written. The
+// pool polls it (never waits on it): its writes go on in the background.
+class TileSink {
+public:
+    virtual ~TileSink() = default;
+    virtual void add(std::span<const TileReport> tiles, std::span<const std::byte> payload) = 0;
+    // Bytes of file space it needs beyond what it was granted (0: none).
+    virtual std::uint64_t wanted() const = 0;
+    virtual void grant(std::uint64_t address, std::uint64_t bytes) = 0;
+    // The tiles written since the last call, where they lie; starts a write of what waits
+    // when none is in flight.
+    virtual std::vector<AppendedTile> written() = 0;
+    // Some tile added has not been returned by written() yet.
+    virtual bool holding() const = 0;
+};
+
+// File space for a writer that asked for `bytes`: its address and size (rounded up to the
+// file system's stripes).
+struct FileSpace {
+    std::uint64_t address = 0;
+    std::uint64_t bytes = 0;
+};
+
+// The writers of compressed tiles beside rank 0. Empty (the default): rank 0 writes every
+// tile (TilesDone), whatever ScheduleSettings::writers says.
+struct Writers {
+    // On every rank but 0: what this rank writes with if the pool makes it a writer.
+    TileSink* sink = nullptr;
+    // Rank 0: tiles another writer wrote, where they lie.
+    std::function<void(std::span<const AppendedTile> tiles)> placed;
+    // Rank 0: file space for a writer that asks (none overlaps another, nor rank 0's own).
+    std::function<FileSpace(std::uint64_t bytes)> grant;
+};
 // Polled on every rank between tiles: true on any rank stops the run. Every rank then
 // finishes the tile it is computing, drops the rest of its blocks, writes and reports
 // what it computed, and returns (the run is interrupted).
@@ -117,6 +161,12 @@ struct ScheduleSettings {
     // first answer after a quiet spell, and of its noticing a stop signal. (Idle, it
     // costs nothing either way; a simulation of hours of cluster time wants fewer looks.)
     double idle_poll_seconds = 1e-3;
+    // Writers of compressed tiles (with Writers given): rank 0 and up to this many - 1 node
+    // leaders, spread evenly over the nodes (each writes for the nodes from its own to the
+    // next writer's); at most one per node, and 1 when the ranks form one node. 0 (auto): one
+    // per node from `auto_writers_ranks` ranks on, else 1.
+    int writers = 1;
+    int auto_writers_ranks = 64;
 };
 
 // What one rank saw of the schedule (for tests, benchmarks and the simulation).
@@ -135,6 +185,10 @@ struct ScheduleStats {
     std::uint64_t asked_back = 0;    // requests for tiles back it sent to the ranks it serves
     double idle_seconds = 0;         // time it waited with nothing to compute (or to serve)
     bool two_level = false;          // node leaders were used (same on every rank)
+    int writers = 1;                 // ranks that wrote compressed tiles (same on every rank)
+    bool writer = false;             // this rank was one of them
+    std::uint64_t tiles_placed = 0;  // tiles it wrote as a writer other than rank 0
+    std::uint64_t grants = 0;        // file space it asked rank 0 for (rank 0: granted), times
     bool leader = false;             // this rank served a node (rank 0 included)
     bool computed = false;           // this rank computed tiles (false: a scheduler only)
 };
@@ -147,7 +201,8 @@ struct PoolPlace {
     bool two_level = false;  // node leaders serve their nodes, rank 0 the leaders
     int node_rank = 0;       // in this rank's node (0: its leader)
     int node_size = 1;
-    int leaders = 0;         // rank 0 with two levels: the number of nodes
+    int leaders = 0;         // a node leader with two levels: the number of nodes
+    int leader_rank = 0;     // a node leader: its rank among the leaders (rank 0: 0)
 };
 
 // A rank that this one serves: one of its node (Level::node), or, on rank 0 with two
@@ -175,6 +230,11 @@ public:
     // The next message from the server into `words` (its size): false when none has
     // arrived and `wait` is false; with `wait`, blocks until one does.
     virtual bool receive_down(std::span<std::uint64_t> words, bool wait) = 0;
+    // Between node leaders (two levels): tiles on their way to the leader that writes them,
+    // `leader` its rank among the leaders.
+    virtual void send_aside(int leader, std::span<const std::uint64_t> words) = 0;
+    // The next message that has arrived from another leader, if any.
+    virtual bool receive_aside(std::vector<std::uint64_t>& words) = 0;
 };
 
 struct PoolResult {
@@ -186,6 +246,10 @@ struct PoolResult {
 // `pending` (the tiles to compute, in the order they are handed out; consecutive entries
 // form the blocks) and settings.
 PoolResult run_pool(PoolLinks& links, const PoolPlace& place, std::span<const std::uint64_t> pending, TileWork& work,
-                    const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings);
+                    const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings,
+                    const Writers& writers = {});
+
+// The writers a run has (ScheduleSettings::writers resolved), the same on every rank.
+int writer_count(const PoolPlace& place, const ScheduleSettings& settings);
 
 }  // namespace superball

@@ -221,6 +221,40 @@ TEST(RunExplore, ScheduleFiguresCountEveryTileOnce)
     }
 }
 
+// Node leaders writing compressed tiles beside rank 0 (ExploreSettings::writers, pseudo-nodes
+// of 2 ranks: two nodes at 3 and 4 ranks, one writer below): the same data whatever the
+// writers, every tile written once by one of them, fresh and after a stop and a resume, in
+// stripes of the job's alignment; a writer count above the nodes' is capped and said.
+TEST(RunExplore, ManyWritersWriteTheSameResult)
+{
+    const SharedDir dir;
+    const Job job = job_of("tile_points = 16\nalignment = 4096\ncheckpoint_seconds = 0.01");
+    const Data want = direct(job);
+    const int nodes = world.size() > 2 ? (world.size() + 1) / 2 : 1;
+    for (const std::uint32_t writers : {0u, 2u, 5u}) {
+        ExploreSettings s = settings(dir / ("w" + std::to_string(writers) + ".h5"));
+        s.node_ranks = 2;
+        s.writers = writers;
+        Tally tally;
+        const RunSummary r = run_explore(job, s, world, tally, never);
+        ASSERT_TRUE(r.complete);
+        const int expected = writers == 0 ? 1 : std::min<int>(static_cast<int>(writers), nodes);  // auto: 1 below 64 ranks
+        EXPECT_EQ(r.schedule.writers, expected) << "writers " << writers;
+        if (expected > 1) {
+            EXPECT_GT(r.schedule.placed_max, 0u) << "a leader wrote tiles";
+        }
+        if (world.is_root()) {
+            const Data got = read_result(s.output);
+            EXPECT_EQ(got.counts, want.counts) << "writers " << writers;
+            EXPECT_EQ(got.outcomes, want.outcomes) << "writers " << writers;
+            const bool capped = static_cast<int>(writers) > nodes;
+            EXPECT_EQ(tally.start.note.find("writers asked") != std::string::npos, capped) << tally.start.note;
+        }
+        s.output = dir / ("w" + std::to_string(writers) + "-resumed.h5");
+        expect_stopped_and_resumed(job, s, want, 5);
+    }
+}
+
 // Tiles handed out interleaved (as from 64 ranks on, job/tiles.hpp handout_order), here at
 // any rank count: the same result, and a stopped run resumes to it (its incomplete
 // granules go last).

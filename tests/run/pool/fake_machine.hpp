@@ -55,7 +55,8 @@ public:
         p.two_level = two_level_;
         p.node_rank = rank % node_of_;
         p.node_size = std::min(node_of_, o_.ranks - rank / node_of_ * node_of_);
-        p.leaders = rank == 0 && two_level_ ? (o_.ranks + node_of_ - 1) / node_of_ : 0;
+        p.leaders = two_level_ ? (o_.ranks + node_of_ - 1) / node_of_ : 1;
+        p.leader_rank = p.node_rank == 0 ? rank / node_of_ : 0;
         return p;
     }
 
@@ -99,6 +100,7 @@ private:
         bool done = false;
         std::deque<Message> up[2];  // from the ranks it serves, by Level
         std::deque<Message> down;   // from its server
+        std::deque<Message> aside;  // from other node leaders
         std::condition_variable turn;  // its turn came, or the run ended
     };
 
@@ -117,6 +119,8 @@ private:
         {
             return m_.receive_down(rank_, words, wait);
         }
+        void send_aside(int leader, std::span<const std::uint64_t> words) override { m_.send_aside(rank_, leader, words); }
+        bool receive_aside(std::vector<std::uint64_t>& words) override { return m_.receive_aside(rank_, words); }
 
     private:
         FakeMachine& m_;
@@ -241,6 +245,22 @@ private:
         const std::lock_guard<std::mutex> guard(mutex_);
         const int dest = to.level == Level::leaders ? to.rank * node_of_ : rank + to.rank;
         deliver(at(dest).down, 0, at(rank).t, words);
+    }
+
+    void send_aside(int rank, int leader, std::span<const std::uint64_t> words)
+    {
+        const std::lock_guard<std::mutex> guard(mutex_);
+        deliver(at(leader * node_of_).aside, rank / node_of_, at(rank).t, words);
+    }
+
+    bool receive_aside(int rank, std::vector<std::uint64_t>& words)
+    {
+        const std::lock_guard<std::mutex> guard(mutex_);
+        std::deque<Message>& box = at(rank).aside;
+        if (box.empty() || box.front().at > at(rank).t) return false;
+        words = std::move(box.front().words);
+        box.pop_front();
+        return true;
     }
 
     std::optional<int> receive_up(int rank, Level level, std::vector<std::uint64_t>& words)
