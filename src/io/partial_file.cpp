@@ -170,13 +170,20 @@ double record_partial_run(const std::filesystem::path& path, double seconds, con
 // ------------------------------------------------------------------------- PartialFile
 
 PartialFile::PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout)
-    : path_(path), comm_(&comm), tiling_(std::move(tiling)), layout_(layout), file_(path)
+    : path_(path), comm_(&comm), tiling_(std::move(tiling)), layout_(layout)
 {
 }
 
+// Opened at once: the threads of the run share the descriptor.
 PartialFile::PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout)
-    : path_(path), comm_(nullptr), tiling_(std::move(tiling)), layout_(layout), file_(path)
+    : path_(path), comm_(nullptr), tiling_(std::move(tiling)), layout_(layout), file_(std::in_place, path)
 {
+}
+
+const PosixFile& PartialFile::file() const
+{
+    if (!file_) file_.emplace(path_);
+    return *file_;
 }
 
 std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
@@ -189,7 +196,7 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
     std::vector<std::uint64_t> bad;
     std::vector<std::byte> counts, outcomes;
     if (layout_.compressed) {
-        const std::uint64_t size = file_.size();
+        const std::uint64_t size = file().size();
         for (std::uint64_t i = begin; i < end; ++i) {
             const StoredChunk& s = stored[i];
             if (s.end() > size || s.end() < s.address) {
@@ -197,7 +204,7 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
                 continue;
             }
             counts.resize(s.counts_bytes + s.outcomes_bytes);
-            file_.read_at(s.address, counts.data(), counts.size());
+            file().read_at(s.address, counts.data(), counts.size());
             const std::span<const std::byte> all(counts);
             if (tile_checksum(done[i], all.first(s.counts_bytes), all.subspan(s.counts_bytes)) != checksums[i]) {
                 bad.push_back(done[i]);
@@ -212,8 +219,8 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
             while (i + n < end && n < run_tiles && done[i + n] == done[i] + n) ++n;
             counts.resize(n * cb);
             outcomes.resize(n * ob);
-            file_.read_at(layout_.counts_at + done[i] * cb, counts.data(), counts.size());
-            file_.read_at(layout_.outcomes_at + done[i] * ob, outcomes.data(), outcomes.size());
+            file().read_at(layout_.counts_at + done[i] * cb, counts.data(), counts.size());
+            file().read_at(layout_.outcomes_at + done[i] * ob, outcomes.data(), outcomes.size());
             for (std::uint64_t j = 0; j < n; ++j) {
                 const std::span<const std::byte> c(counts.data() + j * cb, cb), o(outcomes.data() + j * ob, ob);
                 if (tile_checksum(done[i + j], c, o) != checksums[i + j]) bad.push_back(done[i + j]);

@@ -25,6 +25,7 @@
 #include <deque>
 #include <filesystem>
 #include <future>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -71,9 +72,12 @@ PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& ti
 // every byte of the file (chunks appended past HDF5's own end included).
 double record_partial_run(const std::filesystem::path& path, double seconds, const Provenance& run);
 
-// The partial file opened by every rank of a run, each on its own descriptor.
+// The partial file of a run, opened by each rank that uses it on a descriptor of its own.
 class PartialFile {
 public:
+    // A rank opens the file when it first uses it: of a compressed run only the writers and
+    // a resume's checks do, so thousands of ranks do not queue at the file system's metadata
+    // server to open a file they never touch.
     PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout);
     // For a run in one process without MPI (run/explore_threads.hpp): its threads share the
     // one descriptor (positioned reads and writes), and damaged() checks every tile here.
@@ -82,7 +86,8 @@ public:
     const Tiling& tiling() const { return tiling_; }
     const PartialLayout& layout() const { return layout_; }
     const std::filesystem::path& path() const { return path_; }
-    const PosixFile& file() const { return file_; }
+    // Opens the file on first use (std::system_error naming it if it cannot).
+    const PosixFile& file() const;
 
     // Collective: of the tiles `done` (identical on every rank, ascending) with the
     // checksums recorded for them (and, compressed, where they lie), those whose data no
@@ -90,15 +95,18 @@ public:
     std::vector<std::uint64_t> damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
                                        std::span<const StoredChunk> stored);
 
-    // Closes this rank's descriptor (after every write of the rank's writers).
-    void close() { file_.close(); }
+    // Closes this rank's descriptor, if open (after every write of the rank's writers).
+    void close()
+    {
+        if (file_) file_->close();
+    }
 
 private:
     std::filesystem::path path_;
     const mpi::Comm* comm_;  // nullptr: one process
     Tiling tiling_;
     PartialLayout layout_;
-    PosixFile file_;
+    mutable std::optional<PosixFile> file_;  // opened by file(); the one-process run opens it at once
 };
 
 // Places a tile's values, row-major over its box, in the layout of its chunk: row-major
