@@ -2,24 +2,33 @@
 // with counting and writing replaced by cost models. Compressed (the default): a tile costs
 // what scale_costs computed from a real result of the job, plus its compression at
 // --compress-mbps (smpi_execute, on the rank that counted it); its stored bytes (raw /
-// --compress-ratio) travel to rank 0 in the payloads of the schedule's own report messages
-// (rank -> node leader -> rank 0: the real messages, of the modelled size, over the
-// platform's links, rank 0's included); rank 0 copies them (--copy-gbps) and its appender
-// (ChunkAppender's two buffers and one writer at a time) writes them through rank 0's
-// client (the platform's client_bw) to the shared file system (S4U disk I/O: the disk's
+// --compress-ratio) travel to their writer in the payloads of the schedule's own report
+// messages (rank -> node leader [-> aside to the leader that writes for it] [-> rank 0]:
+// the real messages, of the modelled size, over the platform's links); a writer (rank 0, and
+// with --writers the node leaders the real pool chooses) copies them (--copy-gbps) and its
+// appender (ChunkAppender's two buffers and one write at a time, each write made durable:
+// one more operation) writes them through the writer's own client (the platform's
+// client_bw, one client a writer) to the shared file system (S4U disk I/O: the disk's
 // bandwidth, shared by every operation in flight, after the latency per operation its
-// property op_latency states); a checkpoint every --journal-seconds (the appender flushed,
-// the journal's dirty range written, the file covered); the finish: the tiles indexed in
-// place (--index-us-per-tile of rank 0's CPU each, the index written), the rename, the
-// sidecar. Uncompressed runs (--uncompressed): every rank's writer thread writes its tiles
-// at their offsets; the same finish without the index. Built with smpicxx and run with
-// smpirun by tests/scale/simulate.sh; prints one line of key=value on rank 0.
+// property op_latency states; metadata operations also queue at one metadata server serving
+// mds_ops_per_s); a writer other than rank 0 asks rank 0 for file space through the pool's
+// real messages; a checkpoint every --journal-seconds (rank 0's appender flushed, the
+// journal's dirty range written, the file covered); the finish: the tiles indexed in place
+// (--index-us-per-tile of rank 0's CPU each, the index written), the rename, the sidecar.
+// Uncompressed runs (--uncompressed): every rank's writer thread writes its tiles at their
+// offsets; the same finish without the index. Start-up (MPI_Init and the launch) grows
+// with the ranks (StartupLaw below); --resumed charges a resume's reading of the journal,
+// its broadcast and the check of every done tile; --lose-node-at crashes the whole job.
+// Built with smpicxx and run with smpirun by tests/scale/simulate.sh; prints one line of
+// key=value on rank 0.
 //
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
 //       [--uncompressed] [--flush-bytes 6291456] [--journal-seconds 10] [--compress-mbps 650] [--compress-ratio 100]
-//       [--index-us-per-tile 4] [--copy-gbps 10] [--startup-seconds 2] [--no-io] [--serve-every 0.05] [--server-serve-every 0.005]
+//       [--index-us-per-tile 4] [--copy-gbps 10] [--hash-gbps 10] [--startup-seconds S] [--no-io] [--serve-every 0.05]
+//       [--server-serve-every 0.005] [--writers N (0: auto)] [--alignment 1048576] [--resumed]
 //       [--trace] [--trace-bucket 1] [--noise SIGMA] [--slow-nodes FRACTION:SPEED] [--seed 1]
+//       [--lose-node-at S --lost-record FILE]
 #include <fcntl.h>
 #include <mpi.h>
 #include <smpi/smpi.h>
@@ -42,11 +51,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mpi/mpi.hpp"
@@ -129,10 +140,16 @@ struct Options {
     double create_writes = 16;
     double finish_writes = 36;
     double index_tiles_per_write = 800;
-    // From mpirun starting to the job parsed on every rank: MPI_Init at this many ranks.
-    // An assumption (0.02 s here at 2 ranks with pml ob1; launches of thousands of ranks
-    // over UCX and PMIx take seconds), stated in the output.
-    double startup_seconds = 2;
+    // From mpirun starting to the job parsed on every rank (the launch and MPI_Init);
+    // negative: StartupLaw at this many ranks.
+    double startup_seconds = -1;
+    // How fast a rank computes a done tile's checksum on a resume (XXH3 of its stored
+    // bytes): calibrate.sh measures it (HASH_GBPS), simulate.sh passes it.
+    double hash_gbps = 10;
+    // File space is granted to writers in units of this (the job's [run] alignment).
+    double alignment = 1 << 20;
+    // This run resumes an interrupted one (the costs file holds the tiles left).
+    bool resumed = false;
     bool io = true;
     bool trace = false;            // one line per rank on standard error (where the tail comes from)
     double trace_bucket = 1;       // seconds: the waits between tiles summed over ranks by this
@@ -157,6 +174,7 @@ struct Options {
 Options parse(int argc, char** argv)
 {
     Options o;
+    o.schedule.writers = 0;  // auto, as explore's default
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto value = [&] {
@@ -177,6 +195,10 @@ Options parse(int argc, char** argv)
         else if (a == "--index-us-per-tile") o.index_us_per_tile = std::stod(value());
         else if (a == "--copy-gbps") o.copy_gbps = std::stod(value());
         else if (a == "--startup-seconds") o.startup_seconds = std::stod(value());
+        else if (a == "--hash-gbps") o.hash_gbps = std::stod(value());
+        else if (a == "--writers") o.schedule.writers = std::stoi(value());
+        else if (a == "--alignment") o.alignment = std::stod(value());
+        else if (a == "--resumed") o.resumed = true;
         else if (a == "--no-io") o.io = false;
         else if (a == "--trace") o.trace = true;
         else if (a == "--trace-bucket") o.trace_bucket = std::stod(value());
@@ -205,6 +227,22 @@ Options parse(int argc, char** argv)
     return o;
 }
 
+// The launch and MPI_Init of P ranks, in seconds: 0.226 + 0.2417 sqrt(P), the least-squares
+// fit of a + b sqrt(P) to the MPI_Init times measured with Open MPI under srun on LLNL's
+// opal (flux-framework/flux-core issue 625: 4.34 s at 128 ranks, 6.60 s at 1024, 9.24 at
+// 2048, 17.53 at 4096; the fit's error 1.4 s). The same law gives 67 s at 76,000 ranks,
+// where Intel MPI over UCX measured 68-72 s (openucx/ucx issue 6658); a straight line
+// through the opal points gives 250 s there, and a logarithm 0.4 s at 64 ranks.
+double startup_law(int ranks) { return 0.226 + 0.2417 * std::sqrt(static_cast<double>(ranks)); }
+
+// The one metadata server every rank's metadata operations queue at (the time it is next
+// free), shared by every simulated rank (SMPI runs them in one process, privatization off).
+double& metadata_server_free_at()
+{
+    static double t = 0;
+    return t;
+}
+
 // The shared file system: the disk of the platform's host "fs", which every rank's
 // operations share (its bandwidth is the file system's aggregate), after the latency of an
 // operation (its property op_latency, in seconds: an RPC and a lock on Lustre). Rank 0's
@@ -215,11 +253,11 @@ Options parse(int argc, char** argv)
 // its client.
 class FileSystem {
 public:
-    explicit FileSystem(const Options& o, int rank) : on_(o.io)
+    explicit FileSystem(const Options& o, int rank) : on_(o.io), rank_(rank)
     {
         if (!on_) return;
-        simgrid::s4u::Host* fs = simgrid::s4u::Host::by_name("fs");
-        const auto disks = fs->get_disks();
+        host_ = simgrid::s4u::Host::by_name("fs");
+        const auto disks = host_->get_disks();
         if (disks.empty()) throw std::runtime_error("the platform's host fs has no disk");
         disk_ = disks.front();
         const char* latency = disk_->get_property("op_latency");
@@ -227,25 +265,29 @@ public:
         latency_ = std::stod(latency);
         const char* client = disk_->get_property("client_bw");
         if (!client) throw std::runtime_error("the platform's disk of host fs states no client_bw (bytes/s of one client)");
-        if (rank == 0) {
-            // Created by rank 0 alone, before any I/O; read and write at the client's speed.
-            const double bw = std::stod(client);
-            client_ = fs->create_disk("rank0-client", bw, bw)->seal();
-        }
+        client_bw_ = std::stod(client);
+        const char* mds = disk_->get_property("mds_ops_per_s");
+        if (!mds) throw std::runtime_error("the platform's disk of host fs states no mds_ops_per_s (its metadata server)");
+        mds_service_ = 1 / std::stod(mds);
     }
     void write(double bytes) { io(bytes, true); }
     void read(double bytes) { io(bytes, false); }
-    // An operation on the file system's metadata (create, open, close, rename, unlink): its
-    // latency.
+    // An operation on the file system's metadata (create, open, close, rename, unlink): it
+    // waits its turn at the metadata server, is served, and pays the round trip.
     void metadata()
     {
         if (!on_) return;
         ++operations;
-        simgrid::s4u::this_actor::sleep_for(latency_);
+        const double now = simgrid::s4u::Engine::get_clock();
+        double& free_at = metadata_server_free_at();
+        const double begin = std::max(now, free_at);
+        free_at = begin + mds_service_;
+        metadata_wait += begin - now;
+        simgrid::s4u::this_actor::sleep_until(free_at + latency_);
     }
-    // Rank 0's write of `bytes` in `ops` operations (each pays the latency once; `ops` 0:
+    // This rank's write of `bytes` in `ops` operations (each pays the latency once; `ops` 0:
     // one per MiB, the RPCs Lustre makes of a burst of small writes into the client's cache,
-    // as HDF5's index pages at the finish): the data cross rank 0's client and the file
+    // as HDF5's index pages at the finish): the data cross the rank's client and the file
     // system at once.
     // `calls`: the program's write calls it stands for (the count validate.sh compares).
     void client_write(double bytes, double ops = 1, double calls = 1)
@@ -255,12 +297,22 @@ public:
         operations += static_cast<std::uint64_t>(ops);
         write_calls += static_cast<std::uint64_t>(calls);
         bytes_written += bytes;
-        simgrid::s4u::this_actor::sleep_for(latency_ * ops);
-        const auto n = static_cast<sg_size_t>(std::ceil(bytes));
-        const simgrid::s4u::IoPtr a = disk_->write_async(n);
-        const simgrid::s4u::IoPtr b = client_->write_async(n);
-        a->wait();
-        b->wait();
+        through_client(bytes, ops, true);
+    }
+    // This rank's read of `bytes` in `ops` operations (0: one per MiB), through its client.
+    void client_read(double bytes, double ops = 0)
+    {
+        if (!on_ || bytes <= 0) return;
+        if (ops <= 0) ops = std::ceil(bytes / (1 << 20));
+        operations += static_cast<std::uint64_t>(ops);
+        through_client(bytes, ops, false);
+    }
+    // fdatasync after a write: one more round trip (its data went with the write).
+    void sync()
+    {
+        if (!on_) return;
+        ++operations;
+        simgrid::s4u::this_actor::sleep_for(latency_);
     }
     std::uint64_t operations = 0;
     // The program's write calls as the model makes them (one a client_write or write) and
@@ -268,8 +320,21 @@ public:
     // of the real run's.
     std::uint64_t write_calls = 0;
     double bytes_written = 0;
+    double metadata_wait = 0;  // seconds this rank's metadata operations queued
 
 private:
+    void through_client(double bytes, double ops, bool write)
+    {
+        // One client a rank that writes or reads (a node's own, as each writer is on a node
+        // of its own): made at its first use, read and written at client_bw.
+        if (!client_) client_ = host_->create_disk("client-" + std::to_string(rank_), client_bw_, client_bw_)->seal();
+        simgrid::s4u::this_actor::sleep_for(latency_ * ops);
+        const auto n = static_cast<sg_size_t>(std::ceil(bytes));
+        const simgrid::s4u::IoPtr a = write ? disk_->write_async(n) : disk_->read_async(n);
+        const simgrid::s4u::IoPtr b = write ? client_->write_async(n) : client_->read_async(n);
+        a->wait();
+        b->wait();
+    }
     void io(double bytes, bool write)
     {
         if (!on_ || bytes <= 0) return;
@@ -284,8 +349,12 @@ private:
         else disk_->read(n);
     }
 
-    double latency_ = 0;
     bool on_;
+    int rank_;
+    double latency_ = 0;
+    double client_bw_ = 0;
+    double mds_service_ = 0;
+    simgrid::s4u::Host* host_ = nullptr;
     simgrid::s4u::Disk* disk_ = nullptr;
     simgrid::s4u::Disk* client_ = nullptr;
 };
@@ -350,14 +419,15 @@ private:
     bool busy_ = false;
 };
 
-// Rank 0's writer of compressed tiles (io/partial_file.cpp, ChunkAppender), step by step:
-// two buffers of `capacity` (8 MiB); a batch joins the buffer that fills, which is written
-// at once when no write is in flight (or the one in flight is done), else when it holds
+// A writer of compressed tiles (io/partial_file.cpp, ChunkAppender), step by step: two
+// buffers of `capacity` (8 MiB); a batch joins the buffer that fills, which is written at
+// once when no write is in flight (or the one in flight is done), else when it holds
 // `capacity`; a batch that would take it past `capacity` first sends it off. Sending a
-// buffer off starts its write (a thread of its own: here an S4U actor on rank 0's host) and
-// then waits for the other buffer's write: rank 0 waits only when a buffer fills while the
-// other is still being written (then two writes are in flight for a moment, sharing rank
-// 0's client). flush() (a checkpoint, the end) sends the buffer off and waits for it.
+// buffer off starts its write (a thread of its own: here an S4U actor on the writer's host)
+// and then waits for the other buffer's write: the writer waits only when a buffer fills
+// while the other is still being written (then two writes are in flight for a moment,
+// sharing its client). Each write is made durable (fdatasync) before its tiles count as
+// written. flush() (a checkpoint, the end) sends the buffer off and waits for it.
 class Appender {
 public:
     Appender(FileSystem& fs, double capacity)
@@ -368,7 +438,8 @@ public:
     Appender& operator=(const Appender&) = delete;
     ~Appender() { flush(); }
 
-    void add(double bytes)
+    // `bytes` more, of `tiles` (reported by written() once on disk).
+    void add(double bytes, std::span<const std::uint64_t> tiles = {})
     {
         const double now = simgrid::s4u::Engine::get_clock();
         const auto second = static_cast<std::size_t>(now);
@@ -376,6 +447,7 @@ public:
         ingress_[second] += bytes;
         if (buffer_[current_] > 0 && buffer_[current_] + bytes > capacity_) issue();
         buffer_[current_] += bytes;
+        tiles_[current_].insert(tiles_[current_].end(), tiles.begin(), tiles.end());
         backlog = std::max(backlog, buffer_[0] + buffer_[1]);
         if (buffer_[current_] >= capacity_ || !writing_[1 - current_]) issue();
     }
@@ -384,14 +456,21 @@ public:
         issue();
         wait(1 - current_);
     }
-    // The most payload bytes rank 0 received in one second of the run.
+    // The tiles written since the last call; a write of what waits when none is in flight.
+    std::vector<std::uint64_t> written()
+    {
+        if (!writing_[1 - current_]) issue();
+        return std::exchange(written_, {});
+    }
+    bool holding() const { return buffer_[0] > 0 || buffer_[1] > 0 || !written_.empty(); }
+    // The most payload bytes it received in one second of the run.
     double peak_ingress() const { return ingress_.empty() ? 0.0 : *std::max_element(ingress_.begin(), ingress_.end()); }
 
-    double written = 0;
+    double written_bytes = 0;
     std::uint64_t writes = 0;
     double backlog = 0;      // the most bytes received and not yet written (both buffers)
     double busy_s = 0;       // time with a write in flight
-    double held_back_s = 0;  // time rank 0 waited for a write with a full buffer
+    double held_back_s = 0;  // time its rank waited for a write with a full buffer
 
 private:
     void issue()
@@ -401,16 +480,19 @@ private:
         writing_[b] = true;
         ++writes;
         if (in_flight_++ == 0) busy_since_ = simgrid::s4u::Engine::get_clock();
-        simgrid::s4u::Actor::create("appender-write", simgrid::s4u::this_actor::get_host(), [this, b] {
-            const double bytes = buffer_[b];
-            fs_.client_write(bytes);
-            const std::unique_lock lock(*mutex_);
-            written += bytes;
-            buffer_[b] = 0;
-            writing_[b] = false;
-            if (--in_flight_ == 0) busy_s += simgrid::s4u::Engine::get_clock() - busy_since_;
-            done_->notify_all();
-        });
+        simgrid::s4u::Actor::create("appender-write", simgrid::s4u::this_actor::get_host(),
+                                    [this, b, tiles = std::exchange(tiles_[b], {})] {
+                                        const double bytes = buffer_[b];
+                                        fs_.client_write(bytes);
+                                        fs_.sync();
+                                        const std::unique_lock lock(*mutex_);
+                                        written_bytes += bytes;
+                                        written_.insert(written_.end(), tiles.begin(), tiles.end());
+                                        buffer_[b] = 0;
+                                        writing_[b] = false;
+                                        if (--in_flight_ == 0) busy_s += simgrid::s4u::Engine::get_clock() - busy_since_;
+                                        done_->notify_all();
+                                    });
         current_ = 1 - b;
         const double begin = simgrid::s4u::Engine::get_clock();
         wait(current_);
@@ -427,11 +509,90 @@ private:
     simgrid::s4u::MutexPtr mutex_;
     simgrid::s4u::ConditionVariablePtr done_;
     double buffer_[2] = {0, 0};
+    std::vector<std::uint64_t> tiles_[2];
     bool writing_[2] = {false, false};
     int current_ = 0;
     int in_flight_ = 0;
     double busy_since_ = 0;
+    std::vector<std::uint64_t> written_;
     std::vector<double> ingress_;  // payload bytes received, by second of the run
+};
+
+// A tile's stored bytes: its raw bytes over the job's compression ratio.
+double stored_bytes(const Costs& c, const Options& o, std::uint64_t tile)
+{
+    return static_cast<double>(c.tile_points(tile) * c.bytes_per_point()) / o.compress_ratio;
+}
+
+// A node leader that writes (run/work_pool.hpp TileSink, as run/explore.cpp's AppenderSink
+// over ChunkAppender): it copies each batch (TileBatch::unpack, ChunkAppender's buffer: two
+// copies a byte at --copy-gbps), places its tiles in the file space rank 0 granted it
+// (asking for what waits and a stripe, --alignment, ahead), and writes them with an
+// appender through its own client.
+class SinkModel final : public TileSink {
+public:
+    SinkModel(FileSystem& fs, const Costs& c, const Options& o) : appender(fs, o.append_bytes), fs_(fs), costs_(c), o_(o) {}
+
+    void add(std::span<const TileReport> tiles, std::span<const std::byte> payload) override
+    {
+        if (!opened_) {
+            opened_ = true;
+            fs_.metadata();  // the partial file opened at its first use
+        }
+        const double copy = 2.0 * static_cast<double>(payload.size()) / (o_.copy_gbps * 1e9);
+        smpi_execute(copy);
+        copy_s += copy;
+        for (const TileReport& t : tiles) {
+            const double b = stored_bytes(costs_, o_, t.tile);
+            waiting_.push_back({t.tile, b});
+            waiting_bytes_ += b;
+        }
+        peak_bytes = std::max(peak_bytes, waiting_bytes_ + appender.backlog + static_cast<double>(payload.size()));
+        place();
+    }
+    std::uint64_t wanted() const override
+    {
+        const double need = waiting_bytes_ + o_.alignment;
+        return need > held_ ? static_cast<std::uint64_t>(std::ceil(need - held_)) : 0;
+    }
+    void grant(std::uint64_t, std::uint64_t bytes) override
+    {
+        held_ += static_cast<double>(bytes);
+        place();
+    }
+    std::vector<AppendedTile> written() override
+    {
+        std::vector<AppendedTile> out;
+        for (const std::uint64_t t : appender.written()) {
+            out.push_back({t, t, {0, static_cast<std::uint64_t>(stored_bytes(costs_, o_, t)), 0}});
+        }
+        return out;
+    }
+    bool holding() const override { return !waiting_.empty() || appender.holding(); }
+
+    Appender appender;
+    double copy_s = 0;
+    double peak_bytes = 0;  // the most it held at once: waiting, in its buffers, a message
+
+private:
+    void place()
+    {
+        while (!waiting_.empty() && waiting_.front().second <= held_) {
+            const auto [tile, bytes] = waiting_.front();
+            waiting_.pop_front();
+            held_ -= bytes;
+            waiting_bytes_ -= bytes;
+            appender.add(bytes, std::span<const std::uint64_t>(&tile, 1));
+        }
+    }
+
+    FileSystem& fs_;
+    const Costs& costs_;
+    const Options& o_;
+    bool opened_ = false;
+    std::deque<std::pair<std::uint64_t, double>> waiting_;
+    double waiting_bytes_ = 0;
+    double held_ = 0;
 };
 
 // Counting replaced by smpi_execute of the tile's modelled cost, in pieces with the Serve
@@ -457,16 +618,25 @@ double uniform(std::uint64_t a, std::uint64_t b)
     return static_cast<double>(z >> 11) * 0x1.0p-53;
 }
 
-// The stresses' factor on a tile's compute time on `rank`: noise (lognormal, mean 1) times
-// the slowdown of a slow node.
+// A lognormal factor of mean 1 and log-deviation `sigma`, from two draws of (seed, i)
+// (Box-Muller).
+double lognormal(double sigma, std::uint64_t seed, std::uint64_t i)
+{
+    const double u1 = std::max(uniform(seed, 2 * i), 1e-300), u2 = uniform(seed, 2 * i + 1);
+    const double z = std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
+    return std::exp(sigma * z - sigma * sigma / 2);
+}
+
+// The stresses' factor on a tile's compute time on `rank`: noise (lognormal, mean 1) of the
+// tile and of the rank (a slow core stays slow: Acun, Miller and Kale measured up to 16 %
+// between the processors of one cluster under Turbo Boost, ICS 2016), times the slowdown
+// of a slow node.
 double stress_factor(const Options& o, std::uint64_t tile, int rank)
 {
     double f = 1;
     if (o.noise_sigma > 0) {
-        // Box-Muller from two draws of the tile.
-        const double u1 = std::max(uniform(o.seed, 2 * tile), 1e-300), u2 = uniform(o.seed, 2 * tile + 1);
-        const double z = std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
-        f *= std::exp(o.noise_sigma * z - o.noise_sigma * o.noise_sigma / 2);
+        f *= lognormal(o.noise_sigma, o.seed, tile);
+        f *= lognormal(o.noise_sigma, o.seed + 0x7a4c, static_cast<std::uint64_t>(rank));
     }
     if (o.slow_fraction > 0) {
         const auto node = static_cast<std::uint64_t>(rank / std::max(1, o.schedule.node_ranks));
@@ -514,15 +684,17 @@ public:
         const int pieces = static_cast<int>(std::clamp<std::uint64_t>(wanted, 1, most));
         for (int i = 0; i < pieces; ++i) {
             smpi_execute(cost / pieces);
+            busy += cost / pieces;  // as it goes: what a crash loses of a tile in progress
+            if (shared_busy) *shared_busy = busy;
             if (serve) serve();
         }
-        busy += cost;
         ++tiles;
         last_end = MPI_Wtime();
         next_tile_ = tile + 1;
         buffered_points_ += points;
         buffered_.push_back(tile);
         buffered_bytes_ += options_.compressed ? raw / options_.compress_ratio : raw;
+        max_batch_bytes = std::max(max_batch_bytes, buffered_bytes_);
     }
 
     Flushed flush() override
@@ -551,6 +723,8 @@ public:
     double busy = 0;
     std::uint64_t tiles = 0;
     double payload_bytes = 0;  // compressed bytes this rank sent
+    double max_batch_bytes = 0;  // the most compressed bytes it held before sending them
+    double* shared_busy = nullptr;  // where `busy` is copied for a crash to count
     double last_end = 0;       // set to the start of the run before the first tile
     double bucket = 1;         // of the gaps, in seconds
     std::vector<double> gaps;  // seconds between tiles (and before the first), by bucket of the run their wait began
@@ -583,6 +757,19 @@ private:
     double buffered_bytes_ = 0;
 };
 
+// The modelled memory of a rank beyond its counting's own buffers (explore's, bytes): the
+// hand-out list every rank holds (8 bytes a pending tile); a resume's done tiles with their
+// checksums and places, broadcast to every rank for the check (40 bytes a done tile); on
+// rank 0 the journal (TileJournal: a flag, a checksum and a place, 33 bytes a tile), its
+// appender's two buffers and the largest message it takes; a rank's compressed tiles
+// before it sends them and their packed copy; a writer's waiting tiles, buffers and the
+// largest message; a leader passing its node's tiles on, its outbox of up to 8 MiB and the
+// message it makes of it.
+struct Memory {
+    double list = 0, resume = 0, journal = 0, buffers = 0;
+    double total() const { return list + resume + journal + buffers; }
+};
+
 int run(int argc, char** argv)
 {
     const Options o = parse(argc, argv);
@@ -592,29 +779,90 @@ int run(int argc, char** argv)
     // One mapping for the whole simulation: SMPI runs every rank as a thread of this
     // process (smpi/privatization:no, so this static is shared), one after the other.
     static const Costs costs(o.costs);
+    // Every rank's compute time so far, for a crash (which counts what each had computed):
+    // shared likewise.
+    static std::vector<double> busy_by_rank;
     FileSystem fs(o, rank);
     ModelWork work(costs, fs, o, rank);
+    if (rank == 0) busy_by_rank.assign(static_cast<std::size_t>(ranks), 0.0);
+    world.barrier();
+    work.shared_busy = &busy_by_rank[static_cast<std::size_t>(rank)];
     const double tiles = static_cast<double>(costs.tiles());
+    const double pending = static_cast<double>(costs.pending().size());
+    const double done_tiles = tiles - pending;  // by the runs before (a resume)
+    const double startup = o.startup_seconds >= 0 ? o.startup_seconds : startup_law(ranks);
     // Rank 0's record of the tiles reported done, and how many of them its journal held at
     // the last checkpoint (what a resume finds after a crash).
     std::vector<std::uint64_t> reported_tiles;
     std::size_t recorded = 0;
 
-    // The start (run/explore.cpp, io/partial_file.cpp create_partial): rank 0 creates the
-    // partial file (create, the HDF5 objects and the journal's datasets, a flush: compressed,
-    // 14 KB and 35 bytes a tile in 16 write calls, measured as Options::create_writes was; 9
-    // bytes a tile uncompressed), every rank then opens it (POSIX); the other ranks wait for
-    // its layout.
+    // The start (run/explore.cpp, io/partial_file.cpp create_partial). A new run: rank 0
+    // creates the partial file (create, the HDF5 objects and the journal's datasets, a flush:
+    // compressed, 14 KB and 35 bytes a tile in 16 write calls, measured as
+    // Options::create_writes was; 9 bytes a tile uncompressed). A resume (--resumed): rank 0
+    // looks for an undo log, opens the partial file with HDF5 and reads its journal (33 bytes
+    // a tile); the done tiles, their checksums and places (40 bytes a done tile) are
+    // broadcast to every rank (charged as a scatter and an allgather, van de Geijn's large
+    // broadcast: 2 B / link bandwidth, plus a latency per level of the tree); each rank
+    // opens the file, reads its share of the done tiles one pread each through its client
+    // and hashes them (--hash-gbps), and the ranks gather what they found. Then the ranks
+    // that write open the file (POSIX: a rank opens it when it first uses it; uncompressed,
+    // every rank writes).
     const double journal_bytes_per_tile = o.compressed ? 35.0 : 9.0;
     const double t0 = MPI_Wtime();
-    if (rank == 0) {
-        fs.metadata();
-        const double bytes = journal_bytes_per_tile * tiles + 14336;
-        fs.client_write(bytes, 0, o.create_writes);
-        fs.metadata();
+    double restart_s = 0;
+    if (!o.resumed) {
+        if (rank == 0) {
+            fs.metadata();
+            const double bytes = journal_bytes_per_tile * tiles + 14336;
+            fs.client_write(bytes, 0, o.create_writes);
+            fs.metadata();
+        }
+        world.barrier();
+    } else {
+        static std::vector<std::uint64_t> done;  // the done tiles, in order: rank 0's list, every rank's copy
+        if (rank == 0) {
+            fs.metadata();  // the undo log looked for
+            fs.metadata();  // the HDF5 open
+            fs.client_read(journal_bytes_per_tile * tiles + 14336);
+            fs.metadata();  // the close
+            std::vector<bool> pend(costs.tiles(), false);
+            for (const std::uint64_t t : costs.pending()) pend[t] = true;
+            done.clear();
+            for (std::uint64_t t = 0; t < costs.tiles(); ++t) {
+                if (!pend[t]) done.push_back(t);
+            }
+        }
+        world.barrier();
+        const double bcast = std::ceil(std::log2(std::max(2, ranks))) * 2e-6 + 2 * 40 * done_tiles / 12.5e9;
+        simgrid::s4u::this_actor::sleep_for(bcast);
+        const auto n = static_cast<std::uint64_t>(done.size());
+        const std::uint64_t begin = n * static_cast<std::uint64_t>(rank) / static_cast<std::uint64_t>(ranks);
+        const std::uint64_t end = n * static_cast<std::uint64_t>(rank + 1) / static_cast<std::uint64_t>(ranks);
+        double bytes = 0;
+        for (std::uint64_t i = begin; i < end; ++i) {
+            bytes += o.compressed ? stored_bytes(costs, o, done[i])
+                                  : static_cast<double>(costs.tile_points(done[i]) * costs.bytes_per_point());
+        }
+        if (end > begin) {
+            if (rank != 0) fs.metadata();  // its open
+            fs.client_read(bytes, static_cast<double>(end - begin));
+            smpi_execute(bytes / (o.hash_gbps * 1e9));
+        }
+        world.barrier();
+        restart_s = MPI_Wtime() - t0;
     }
-    world.barrier();
-    fs.metadata();
+
+    // Who writes (the real pool's choice, src/run/work_pool.cpp): rank 0, and the node
+    // leaders it makes writers; they open the file. Rank 0 grants them file space in stripes.
+    const int writer_count = o.compressed ? schedule_writers(world, o.schedule) : 1;
+    std::optional<SinkModel> sink;
+    Writers writing;
+    double next_free = 0;
+    std::uint64_t root_grants = 0;
+    if (o.compressed && writer_count > 1 && rank != 0) writing.sink = &sink.emplace(fs, costs, o);
+    const bool opens = !o.compressed || rank == 0;  // the sinks' writers open the file at their first write, below
+    if (opens && !(o.resumed && rank != 0)) fs.metadata();
     world.barrier();
 
     // Rank 0: the appender of compressed tiles, and a checkpoint every journal_seconds
@@ -653,22 +901,28 @@ int run(int argc, char** argv)
     };
     // Progress on standard error every tenth of the tiles: long simulations are long.
     std::uint64_t reported = 0;
-    std::uint64_t next_mark = costs.tiles() / 10;
+    std::uint64_t next_mark = costs.pending().size() / 10;
     const auto wall_start = std::chrono::steady_clock::now();
     double copy_s = 0;
+    const auto record = [&](std::uint64_t tile) {
+        dirty_begin = std::min(dirty_begin, tile);
+        dirty_end = std::max(dirty_end, tile + 1);
+        reported_tiles.push_back(tile);
+        if (++reported >= next_mark && next_mark > 0) {
+            std::fprintf(stderr, "sim_run: %llu of %zu tiles reported at %.1f simulated s, %.0f s of wall time\n",
+                         static_cast<unsigned long long>(reported), costs.pending().size(), MPI_Wtime(),
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
+            next_mark += costs.pending().size() / 10;
+        }
+    };
+    const auto maybe_checkpoint = [&] {
+        if (MPI_Wtime() >= next_journal) {
+            next_journal = MPI_Wtime() + o.journal_seconds;
+            checkpoint(true);
+        }
+    };
     const TilesDone done = [&](std::span<const TileReport> tiles_done, int, std::span<const std::byte> payload) {
-        reported += tiles_done.size();
-        if (reported >= next_mark && next_mark > 0) {
-            std::fprintf(stderr, "sim_run: %llu of %llu tiles reported at %.1f simulated s, %.0f s of wall time\n",
-                         static_cast<unsigned long long>(reported), static_cast<unsigned long long>(costs.tiles()),
-                         MPI_Wtime(), std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
-            next_mark += costs.tiles() / 10;
-        }
-        for (const TileReport& t : tiles_done) {
-            dirty_begin = std::min(dirty_begin, t.tile);
-            dirty_end = std::max(dirty_end, t.tile + 1);
-            reported_tiles.push_back(t.tile);
-        }
+        for (const TileReport& t : tiles_done) record(t.tile);
         if (appender) {
             // TileBatch::unpack's copy and ChunkAppender::add's, on rank 0's main thread.
             const double copy = 2.0 * static_cast<double>(payload.size()) / (o.copy_gbps * 1e9);
@@ -676,43 +930,55 @@ int run(int argc, char** argv)
             copy_s += copy;
             appender->add(static_cast<double>(payload.size()));
         }
-        if (MPI_Wtime() >= next_journal) {
-            next_journal = MPI_Wtime() + o.journal_seconds;
-            checkpoint(true);
-        }
+        maybe_checkpoint();
     };
+    if (rank == 0 && writer_count > 1) {
+        writing.placed = [&](std::span<const AppendedTile> placed) {
+            for (const AppendedTile& t : placed) record(t.tile);
+            maybe_checkpoint();
+        };
+        writing.grant = [&](std::uint64_t bytes) {
+            const double unit = o.alignment;
+            const FileSpace f{static_cast<std::uint64_t>(next_free),
+                              static_cast<std::uint64_t>(std::ceil(static_cast<double>(bytes) / unit) * unit)};
+            next_free += static_cast<double>(f.bytes);
+            ++root_grants;
+            return f;
+        };
+    }
     world.barrier();
     const double start = MPI_Wtime();
     work.last_end = start;
     work.bucket = o.trace_bucket;
-    // A lost node: every rank stops at that time (the job dies; the schedule's own stop
-    // ends the simulation there, and what happens after is not counted).
-    const StopRequested lost = [&] { return o.lose_node_at >= 0 && MPI_Wtime() - start >= o.lose_node_at; };
-    const ScheduleResult r = run_schedule(world, costs.pending(), work, done, lost, o.schedule);
-    if (o.lose_node_at >= 0) {
-        // The work lost: everything counted (and compressed) by the time of the loss less
-        // the work of the tiles the journal recorded.
-        double busy = work.busy;
-        mpi::check(MPI_Allreduce(MPI_IN_PLACE, &busy, 1, MPI_DOUBLE, MPI_SUM, world.get()), "MPI_Allreduce");
-        if (rank == 0) {
-            double kept = 0;
+    // A lost node: the job dies with it at that moment, every rank at once (an actor of rank
+    // 0's sleeps until then and ends the simulation): what its journal recorded at the last
+    // checkpoint stands, everything else counted is lost. Nothing after it is counted.
+    if (o.lose_node_at >= 0 && rank == 0) {
+        simgrid::s4u::Actor::create("node-lost", simgrid::s4u::this_actor::get_host(), [&] {
+            simgrid::s4u::this_actor::sleep_until(start + o.lose_node_at);
+            double busy = 0, kept = 0;
+            for (const double b : busy_by_rank) busy += b;
             for (std::size_t i = 0; i < recorded; ++i) {
                 const std::uint64_t t = reported_tiles[i];
                 const double raw = static_cast<double>(costs.tile_points(t) * costs.bytes_per_point());
                 kept += costs.cost(t) + (o.compressed ? raw / (o.compress_mbps * 1e6) : 0.0);
             }
             std::FILE* f = std::fopen(o.lost_record.c_str(), "wb");
-            if (f == nullptr) throw std::runtime_error("cannot write " + o.lost_record);
-            const std::size_t wrote = std::fwrite(reported_tiles.data(), sizeof(std::uint64_t), recorded, f);
-            if (std::fclose(f) != 0 || wrote != recorded) throw std::runtime_error("cannot write " + o.lost_record);
-            std::printf("lost_node_at_s=%.6g lost_at_s=%.6g recorded_tiles=%zu reported_tiles=%zu pending_tiles=%zu "
-                        "work_s=%.6g recorded_work_s=%.6g lost_work_s=%.6g\n",
-                        o.lose_node_at, o.startup_seconds + (MPI_Wtime() - t0), recorded, reported_tiles.size(),
+            const std::size_t wrote = f ? std::fwrite(reported_tiles.data(), sizeof(std::uint64_t), recorded, f) : 0;
+            if (f == nullptr || std::fclose(f) != 0 || wrote != recorded) {
+                std::fprintf(stderr, "sim_run: cannot write %s\n", o.lost_record.c_str());
+                std::_Exit(1);
+            }
+            std::printf("lost_node_at_s=%.6g lost_at_s=%.6g startup_s=%.6g recorded_tiles=%zu reported_tiles=%zu "
+                        "pending_tiles=%zu work_s=%.6g recorded_work_s=%.6g lost_work_s=%.6g\n",
+                        o.lose_node_at, startup + (MPI_Wtime() - t0), startup, recorded, reported_tiles.size(),
                         costs.pending().size(), busy, kept, busy - kept);
             std::fflush(stdout);
-        }
-        return 0;
+            std::fflush(stderr);
+            std::_Exit(0);
+        })->daemonize();
     }
+    const ScheduleResult r = run_schedule(world, costs.pending(), work, done, [] { return false; }, o.schedule, writing);
     const double scheduled = world.max(MPI_Wtime());
     if (o.trace) {
         // Every rank's time between tiles, summed by second of the run: where the waits are.
@@ -765,13 +1031,28 @@ int run(int argc, char** argv)
     }
     world.barrier();
     const double end = MPI_Wtime();
-    const double written = appender ? appender->written : 0.0;
+    const double written = appender ? appender->written_bytes : 0.0;
     const double writes = appender ? static_cast<double>(appender->writes) : 0.0;
     const double backlog = appender ? appender->backlog : 0.0;
     const double writer_busy = appender ? appender->busy_s : 0.0;
     const double held_back = appender ? appender->held_back_s : 0.0;
     const double peak_ingress = appender ? appender->peak_ingress() : 0.0;
     appender.reset();
+    const bool sink_wrote = sink && r.stats.writer;
+    const double sink_bytes = sink_wrote ? sink->appender.written_bytes : 0.0;
+    const double sink_held_back = sink_wrote ? sink->appender.held_back_s : 0.0;
+    const double sink_peak_ingress = sink_wrote ? sink->appender.peak_ingress() : 0.0;
+
+    // The memory model (Memory above), this rank's.
+    Memory mem;
+    mem.list = 8 * pending;
+    mem.resume = o.resumed ? 40 * done_tiles : 0.0;
+    mem.journal = rank == 0 ? 33 * tiles : 0.0;
+    const double message = 8 << 20;  // the largest message a server takes: a leader's 8 MiB of its node's
+    mem.buffers = 2 * work.max_batch_bytes;
+    if (rank == 0 && o.compressed) mem.buffers += 2 * o.append_bytes + message;
+    if (sink_wrote) mem.buffers += std::max(sink->peak_bytes, 2 * o.append_bytes) + message;
+    if (r.stats.leader && rank != 0 && !r.stats.writer && o.compressed) mem.buffers += 2 * message;
 
     // Reductions, not a gather: SMPI's gather to one rank of 4096 waits on its requests one
     // by one (minutes of wall time).
@@ -785,38 +1066,45 @@ int run(int argc, char** argv)
     const std::vector<double> mins = reduce({r.stats.computed ? last : 1e300, r.stats.computed ? tiles_here : 1e300}, MPI_MIN);
     const std::vector<double> maxs =
         reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start,
-                r.stats.computed ? tiles_here : 0.0},
+                r.stats.computed ? tiles_here : 0.0, sink_bytes, sink_held_back, sink_peak_ingress, mem.total(),
+                rank != 0 ? mem.total() : 0.0, fs.metadata_wait},
                MPI_MAX);
     const std::vector<double> sums = reduce({static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
                                              r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes,
-                                             r.stats.computed ? 1.0 : 0.0, static_cast<double>(fs.write_calls), fs.bytes_written},
+                                             r.stats.computed ? 1.0 : 0.0, static_cast<double>(fs.write_calls), fs.bytes_written,
+                                             sink_bytes, sink ? sink->copy_s : 0.0},
                                             MPI_SUM);
     if (rank == 0) {
         double total = 0;
         for (const std::uint64_t t : costs.pending()) total += costs.cost(t);  // (every tile, unless resumed)
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
+        const double writer_bytes_max = maxs[4], writer_held_back = maxs[5], writer_peak_ingress = maxs[6];
+        const double rank_mib = maxs[7] / (1 << 20), other_mib = maxs[8] / (1 << 20), metadata_wait = maxs[9];
         const double ops = sums[0], given_back = sums[1], idle = sums[2], payload = sums[3], computing = sums[4],
-                     write_calls = sums[5], bytes_written = sums[6];
+                     write_calls = sums[5], bytes_written = sums[6], by_writers = sums[7], writers_copy = sums[8];
         const double tiles_min = mins[1], tiles_max = maxs[3];
-        // From mpirun starting (the stated start-up) to the result renamed; and the compute
-        // phase, from the first tile handed out to the last done, as explore reports it.
-        const double end_to_end = o.startup_seconds + (end - t0);
+        // From mpirun starting (the start-up) to the result renamed; and the compute phase,
+        // from the first tile handed out to the last done, as explore reports it.
+        const double end_to_end = startup + (end - t0);
         const double ideal = total / ranks;
         std::printf("ranks=%d efficiency=%.4f end_to_end=%.4f predicted_s=%.6g ideal_s=%.6g compute_s=%.6g schedule_s=%.6g "
-                    "startup_s=%.6g create_s=%.6g finish_s=%.6g after_compute_s=%.6g tail_s=%.6g tiles=%llu root_requests=%llu "
-                    "root_messages=%llu max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d given_back=%.0f "
-                    "root_asked_back=%llu idle_s_per_rank=%.6g reported=%llu compressed=%d payload_bytes=%.6g "
+                    "startup_s=%.6g create_s=%.6g restart_s=%.6g finish_s=%.6g after_compute_s=%.6g tail_s=%.6g tiles=%llu "
+                    "root_requests=%llu root_messages=%llu max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d "
+                    "given_back=%.0f root_asked_back=%llu idle_s_per_rank=%.6g reported=%llu compressed=%d payload_bytes=%.6g "
                     "written_by_root=%.6g root_writes=%.0f writer_busy_s=%.6g writer_backlog_bytes=%.6g root_held_back_s=%.6g "
                     "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g checkpoint_s=%.6g computing_ranks=%.0f tiles_min=%.0f "
-                    "tiles_max=%.0f write_calls=%.0f bytes_written=%.0f\n",
-                    ranks, ideal / (scheduled - start), ideal / end_to_end, end_to_end, ideal, total, schedule_s,
-                    o.startup_seconds, start - t0, end - finish_start, end - scheduled, last_busy - first_idle,
+                    "tiles_max=%.0f write_calls=%.0f bytes_written=%.0f writers=%d written_by_writers=%.6g "
+                    "writer_bytes_max=%.6g writer_held_back_max_s=%.6g writer_peak_ingress_bytes_per_s=%.6g writers_copy_s=%.6g "
+                    "root_grants=%llu metadata_wait_max_s=%.6g rank_mib=%.1f root_mib=%.1f other_rank_mib=%.1f\n",
+                    ranks, ideal / (scheduled - start), ideal / end_to_end, end_to_end, ideal, total, schedule_s, startup,
+                    start - t0 - restart_s, restart_s, end - finish_start, end - scheduled, last_busy - first_idle,
                     static_cast<unsigned long long>(costs.tiles()), static_cast<unsigned long long>(r.stats.requests_in),
                     static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(), ops,
                     r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back), idle / ranks,
                     static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writes, writer_busy,
                     backlog, held_back, peak_ingress, copy_s, checkpoint_s, computing, tiles_min, tiles_max, write_calls,
-                    bytes_written);
+                    bytes_written, writer_count, by_writers, writer_bytes_max, writer_held_back, writer_peak_ingress, writers_copy,
+                    static_cast<unsigned long long>(root_grants), metadata_wait, rank_mib, mem.total() / (1 << 20), other_mib);
         std::fflush(stdout);
     }
     return 0;

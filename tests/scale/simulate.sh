@@ -4,39 +4,54 @@
 # OUT/sim_run) and cost models for counting and writing. Prints one line per job and rank
 # count:
 #
-#   job=NAME ranks=N tile_points=T efficiency=E end_to_end=E2 predicted_s=S
+#   job=NAME ranks=N tile_points=T efficiency=E end_to_end=E2 predicted_s=S rank_mib=M
 #
 # ideal = the job's total counting / N; efficiency = ideal / the compute phase (the first
 # tile handed out to the last one reported, as explore's "computed in"); end_to_end =
-# ideal / S, S the predicted time from mpirun starting to the result renamed: a stated
-# start-up (--startup-seconds, default 2 s for MPI_Init at thousands of ranks: an
-# assumption, see README.md), rank 0 creating the partial file and every rank opening it,
-# the compute phase, rank 0's last write, journal and finish. T: the job's tile (= chunk)
-# points at N ranks. The details of each run (schedule and finish times, the tail,
-# messages rank 0 received, tiles given back, file-system operations, rank 0's writer: the
-# bytes it wrote, its writes, its largest backlog, its busiest second of payload received)
-# are in OUT/logs/NAME.N.log.
+# ideal / S, S the predicted time from mpirun starting to the result renamed: the start-up
+# (the launch and MPI_Init: 0.226 + 0.2417 sqrt(N) s, fitted to Open MPI's measured under
+# srun, sim_run.cpp startup_law; --startup-seconds S states another), rank 0 creating the
+# partial file and the writers opening it (each open queueing at the metadata server), the
+# compute phase, the last writes, rank 0's journal and finish. T: the job's tile (= chunk)
+# points at N ranks. M: the largest rank's modelled memory beyond the counting's own
+# buffers (the hand-out list, rank 0's journal, the writers' and senders' buffers, a
+# resume's done tiles; sim_run.cpp Memory), MiB. The details of each run (schedule and
+# finish times, the tail, messages rank 0 received, tiles given back, file-system
+# operations, the writers: the bytes each wrote, their waits, their busiest second of
+# payload received; rank 0's own writer; memory by part) are in OUT/logs/NAME.N.log.
 #
 #   tests/scale/simulate.sh [--ranks "64 256 1024 4096"] [--startup-seconds S] [--tile-points T]
-#                           [--ratio-boxes K] [--sample-points P] [--out DIR] [--no-build]
+#                           [--weak F] [--writers N|auto] [--ratio-boxes K] [--sample-points P]
+#                           [--out DIR] [--no-build]
 #                           [--latency-factor F] [--bandwidth-factor F] [--fs-bandwidth-factor F]
 #                           [--metadata-factor F] [--noise SIGMA] [--slow-nodes FRACTION:SPEED]
 #                           [--lose-node] [--requeue-seconds S]
 #                           [JOB.toml...]
 #
-# Stresses (defaults: none, the platform of tests/scale/cluster.xml): --latency-factor
-# multiplies the latencies of the links between nodes (10: ten times slower), --bandwidth-factor their
-# bandwidths (0.1: ten times slower); --fs-bandwidth-factor multiplies the file system's
-# bandwidth and one client's; --metadata-factor multiplies the file system's cost per
-# operation (create, open, rename and every write's RPC); --noise SIGMA multiplies each tile's
-# compute time by a lognormal factor of mean 1 (0.05: about +-5 %); --slow-nodes 0.05:0.5
-# makes 5 % of the nodes (a seeded draw) count at half speed. The efficiencies stay relative
-# to the unstressed ideal. --lose-node: a node is lost halfway through the ideal time, the
-# MPI job dies with it, is requeued (--requeue-seconds S in the queue, default 0) and resumes
-# from what its journal recorded; the line then adds lost_at_s, lost_work_s (core-seconds
-# counted and lost) and recorded_tiles, and predicted_s / end_to_end are the whole: until the
-# loss, the queue, the resumed run (efficiency: the resumed run's compute phase). A stressed
-# run's logs are NAME.STRESS.N.log.
+# --weak F: the job scaled up, its longest grid axis F times as many samples, its tiles F
+# times as many points when the job sets them (else the default tiling grows them with the
+# ranks' shares), so that the number of tiles, and the simulation's cost, stays about the
+# same (logs NAME.weakF...). --writers: who writes the compressed result (explore
+# --writers; default auto: one writer per node from 64 ranks on).
+# Stresses (defaults: none, the platform of tests/scale/cluster.xml), each a flag, any of
+# them at once: --latency-factor multiplies the latencies of the links between nodes (10:
+# ten times slower), --bandwidth-factor their bandwidths (0.1: ten times slower);
+# --fs-bandwidth-factor multiplies the file system's bandwidth and each client's;
+# --metadata-factor multiplies the file system's cost per operation (every operation's
+# latency, and the metadata server's time for each of its own); --noise SIGMA multiplies
+# each tile's compute time by a lognormal factor of mean 1 (0.05: about +-5 %) and each
+# rank's speed by another (a slow core stays slow); --slow-nodes 0.05:0.5 makes 5 % of the
+# nodes (a seeded draw) count at half speed. The efficiencies stay relative to the
+# unstressed ideal. --lose-node: a node is lost halfway through the ideal time and the MPI
+# job dies with it at once (a crash: no tile in flight finishes, no checkpoint is written);
+# it is requeued and resumes from what its journal recorded at its last checkpoint,
+# paying a second start-up, the journal read, the done tiles broadcast and each checked
+# against its checksum. The line then adds lost_at_s, lost_work_s (core-seconds counted
+# and lost), recorded_tiles and requeue_s (--requeue-seconds S, default 420: Slurm's
+# SlurmdTimeout of 300 s before a silent node is marked down and its requeue_delay of
+# 120 s; stated, not counted), and predicted_s / end_to_end are the whole over both runs:
+# until the loss, then the resumed run (efficiency: the resumed run's compute phase). A
+# stressed run's logs are NAME.STRESS.N.log.
 #
 # Default: every job of jobs/cluster, OUT = build/scale. --tile-points: run the jobs in tiles
 # of T points whatever they or the default say (the logs are then NAME.tpT.N.log).
@@ -76,7 +91,9 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 cd "$root"
 ranks="64 256 1024 4096"
-startup=2
+startup=
+weak=1
+writers=auto
 out=$root/build/scale
 build=true
 tile_points=
@@ -86,12 +103,14 @@ latency_factor=1 bandwidth_factor=1 fs_bandwidth_factor=1 metadata_factor=1
 stress_args=()
 stress=
 lose_node=false
-requeue=0
+requeue=420
 jobs=()
 while (($# > 0)); do
   case $1 in
     --ranks) ranks=$2; shift 2 ;;
     --startup-seconds) startup=$2; shift 2 ;;
+    --weak) weak=$2; shift 2 ;;
+    --writers) writers=$2; shift 2 ;;
     --tile-points) tile_points=$2; shift 2 ;;
     --ratio-boxes) ratio_boxes=$2; shift 2 ;;
     --sample-points) sample_points=$2; shift 2 ;;
@@ -105,12 +124,18 @@ while (($# > 0)); do
     --requeue-seconds) requeue=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --no-build) build=false; shift ;;
-    -h|--help) sed -n '2,70p' "$0"; exit 0 ;;
-    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --ratio-boxes, --sample-points, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --help)" >&2; exit 2 ;;
+    -h|--help) sed -n '2,100p' "$0"; exit 0 ;;
+    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --weak, --writers, --ratio-boxes, --sample-points, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --help)" >&2; exit 2 ;;
     *) jobs+=("$1"); shift ;;
   esac
 done
 ((${#jobs[@]} > 0)) || jobs=(jobs/cluster/*.toml)
+[[ $weak =~ ^[1-9][0-9]*$ ]] || { echo "simulate: --weak $weak: accepted a whole factor >= 1" >&2; exit 2; }
+case $writers in
+  auto) writers_arg=0 ;;
+  *) [[ $writers =~ ^[1-9][0-9]*$ ]] || { echo "simulate: --writers $writers: accepted auto or a count >= 1" >&2; exit 2; }
+     writers_arg=$writers ;;
+esac
 
 out=$(realpath -m "$out")
 bin=${SUPERBALL_BUILD_DIR:-$root/build/release}
@@ -138,6 +163,28 @@ smpi=(--cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/pr
 
 for job in "${jobs[@]}"; do
   name=$(basename "$job" .toml)
+  if ((weak > 1)); then
+    # The job scaled up (--weak): its longest axis F times as many samples, its own tiles
+    # (when it sets them) F times as many points.
+    /usr/bin/python3 - "$job" "$out/jobs/$name.weak$weak.toml" "$weak" <<'EOF'
+import sys, tomllib
+sys.path.insert(0, "tests/scale")
+from lowres_job import value
+job = tomllib.load(open(sys.argv[1], "rb"))
+f = int(sys.argv[3])
+axes = [k for k, v in job["grid"].items() if isinstance(v, dict)]
+longest = max(axes, key=lambda k: job["grid"][k]["n"])
+job["grid"][longest]["n"] *= f
+if "tile_points" in job.get("run", {}):
+    job["run"]["tile_points"] *= f
+with open(sys.argv[2], "w") as out:
+    for t in ("model", "grid", "run"):
+        if t in job:
+            out.write(f"[{t}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in job[t].items()))
+EOF
+    job=$out/jobs/$name.weak$weak.toml
+    name=$name.weak$weak
+  fi
   if [[ -n $tile_points ]]; then
     # The job in tiles of --tile-points points: a copy with [run] tile_points set.
     /usr/bin/python3 - "$job" "$out/jobs/$name.tp$tile_points.toml" "$tile_points" <<'EOF'
@@ -207,8 +254,9 @@ EOF
       cat "$ratio_file" >>"$log"
       ratio=$(sed -n 's/.* ratio=\([^ ]*\).*/\1/p' "$ratio_file")
       compress_mbps=$(sed -n 's/.* compress_mbps=\([^ ]*\).*/\1/p' "$ratio_file")
+      alignment=$(/usr/bin/python3 -c 'import sys, tomllib; print(tomllib.load(open(sys.argv[1], "rb")).get("run", {}).get("alignment", 1048576))' "$job")
       write=(--compress-mbps "$compress_mbps" --compress-ratio "$ratio" --index-us-per-tile "$INDEX_US_PER_TILE"
-             --copy-gbps "$COPY_GBPS")
+             --copy-gbps "$COPY_GBPS" --hash-gbps "$HASH_GBPS" --writers "$writers_arg" --alignment "$alignment")
     fi
     # Serve is called every 512 points in the real counter; the model calls it at least
     # every 1/2000 of the ideal run time (0.05 s at 4096 ranks), which keeps the number of
@@ -220,13 +268,13 @@ EOF
     sim() {  # COSTS [more sim_run options]
       smpirun -np "$n" -platform "$platform" -hostfile "$out/hosts" "$out/sim_run" "$1" \
         --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" "${write[@]}" \
-        --startup-seconds "$startup" "${stress_args[@]}" "${@:2}" "${smpi[@]}" >>"$log" 2>&1
+        ${startup:+--startup-seconds "$startup"} "${stress_args[@]}" "${@:2}" "${smpi[@]}" >>"$log" 2>&1
     }
     extra=
     if $lose_node; then
-      # A node lost halfway through the ideal time: the job dies; it is requeued
-      # (--requeue-seconds in the queue, default 0: the queue's wait is the cluster's) and
-      # resumes from the tiles its journal recorded at the last checkpoint.
+      # A node lost halfway through the ideal time: the job dies at once; it is requeued
+      # (--requeue-seconds, stated) and resumes from the tiles its journal recorded at the
+      # last checkpoint, paying what a resume pays (sim_run --resumed).
       ideal=$(field ideal_s)
       at=$(/usr/bin/python3 -c "print(float('$ideal') / 2)")
       sim "$costs" --lose-node-at "$at" --lost-record "$out/costs/$label.$n.lost"
@@ -234,7 +282,7 @@ EOF
       [[ -n $lost ]] || { echo "simulate: no lost-node result for $label at $n ranks; see $log" >&2; exit 1; }
       "$scale_costs" "$job" "$n" "$out/lowres/$lowname.h5" "$NS_PER_POINT" "$ns_per_iteration" "$US_PER_TILE" "$costs.resumed" \
         "$out/costs/$label.$n.lost" >>"$log"
-      sim "$costs.resumed"
+      sim "$costs.resumed" --resumed
       rm -f "$costs.resumed" "$out/costs/$label.$n.lost"
     else
       sim "$costs"
@@ -242,23 +290,25 @@ EOF
     echo "simulate: $label at $n ranks took $((SECONDS - start)) s of wall time" >>"$log"
     line=$(grep '^ranks=' "$log" | tail -1)
     [[ -n $line ]] || { echo "simulate: no result for $label at $n ranks; see $log" >&2; exit 1; }
+    rank_mib=$(sed -n 's/.* rank_mib=\([^ ]*\).*/\1/p' <<<"$line")
     efficiency=$(sed -n 's/.* efficiency=\([^ ]*\).*/\1/p' <<<"$line")
     end_to_end=$(sed -n 's/.* end_to_end=\([^ ]*\).*/\1/p' <<<"$line")
     predicted=$(sed -n 's/.* predicted_s=\([^ ]*\).*/\1/p' <<<"$line")
     if $lose_node; then
-      # The whole: the first run until the loss, the queue, the resumed run; against the
-      # whole job's ideal. efficiency stays the resumed run's compute phase's.
+      # The whole: the first run until the loss, then the resumed run; against the whole
+      # job's ideal (the queue's wait stated, not counted: it is the cluster's). efficiency
+      # stays the resumed run's compute phase's.
       read -r predicted end_to_end extra < <(/usr/bin/python3 - "$lost" "$predicted" "$requeue" "$(field ideal_s)" <<'PYX'
 import sys
 kv = dict(x.split("=") for x in sys.argv[1].split())
 lost_at, resumed, requeue, ideal = float(kv["lost_at_s"]), float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
-total = lost_at + requeue + resumed
+total = lost_at + resumed
 print(f"{total:.6g} {ideal / total:.4f} lost_at_s={lost_at:.6g} lost_work_s={float(kv['lost_work_s']):.6g} "
       f"recorded_tiles={kv['recorded_tiles']} requeue_s={requeue:g}")
 PYX
       )
     fi
-    echo "job=$label ranks=$n tile_points=$points efficiency=$efficiency end_to_end=$end_to_end predicted_s=$predicted${extra:+ $extra}"
+    echo "job=$label ranks=$n tile_points=$points efficiency=$efficiency end_to_end=$end_to_end predicted_s=$predicted rank_mib=$rank_mib${extra:+ $extra}"
     rm -f "$costs"
   done
 done

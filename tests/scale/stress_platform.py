@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """The platform of a stressed scaling simulation (tests/scale/simulate.sh): cluster.xml with
 the network's latencies and bandwidths, the file system's bandwidths (its disk's and one
-client's) and its cost per operation multiplied by the given factors.
+client's) and its cost per operation (the latency of every operation, and the time the
+metadata server takes for each of its own) multiplied by the given factors.
 
     platform.py CLUSTER.xml OUT.xml LATENCY_FACTOR BANDWIDTH_FACTOR FS_BANDWIDTH_FACTOR METADATA_FACTOR
 """
@@ -27,6 +28,7 @@ def main():
     x = re.sub(r'(\b(?:read|write)_bw=)"([0-9.]+)([kMG]?)Bps"', rate(fsbw), x)
     x = re.sub(r'(<prop id="client_bw" value=)"([0-9.e+]+)"', lambda m: f'{m.group(1)}"{float(m.group(2)) * fsbw:.6g}"', x)
     x = re.sub(r'(<prop id="op_latency" value=)"([0-9.e+-]+)"', lambda m: f'{m.group(1)}"{float(m.group(2)) * meta:.6g}"', x)
+    x = re.sub(r'(<prop id="mds_ops_per_s" value=)"([0-9.e+-]+)"', lambda m: f'{m.group(1)}"{float(m.group(2)) / meta:.6g}"', x)
     with open(dst, "w") as f:
         f.write(x)
 
