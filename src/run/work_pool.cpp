@@ -454,7 +454,7 @@ private:
         if (aside_to_ < 0 || (aside_groups_ == 0 && !last)) return;
         std::vector<std::uint64_t> msg{last ? 1u : 0u, aside_groups_};
         msg.insert(msg.end(), aside_.begin(), aside_.end());
-        aside_.clear();
+        std::vector<std::uint64_t>().swap(aside_);
         aside_groups_ = 0;
         next_aside_ = links_.now() + settings_.report_seconds / 2;
         links_.send_aside(aside_to_, msg);
@@ -505,7 +505,9 @@ private:
         msg.insert(msg.end(), outbox_.begin(), outbox_.end());
         msg.push_back(given.size());
         for (const Range& r : given) msg.insert(msg.end(), {r.first, r.count});
-        outbox_.clear();
+        // Its memory too: a rank's batch of compressed tiles passes through it once a second or
+        // at 4 MiB, and kept, that much would stay on every rank for the rest of the run.
+        std::vector<std::uint64_t>().swap(outbox_);
         outbox_groups_ = 0;
         next_forward_ = links_.now() + settings_.report_seconds / 2;
         links_.send_up(msg);
