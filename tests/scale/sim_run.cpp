@@ -650,7 +650,7 @@ public:
     ModelWork(const Costs& c, FileSystem& fs, const Options& o, int rank)
         : rank_(rank),
           costs_(c),
-          writer_(fs, rank),
+          writer_(o.compressed ? std::nullopt : std::make_optional<WriterThread>(fs, rank)),
           options_(o),
           flush_bytes_(o.flush_bytes),
           serve_every_(o.serve_every),
@@ -712,7 +712,7 @@ public:
             return out;
         }
         issue();
-        writer_.wait();
+        writer_->wait();
         for (const std::uint64_t t : written_) out.reports.push_back({t, t});
         written_.clear();
         return out;
@@ -735,7 +735,7 @@ private:
         if (buffered_points_ == 0) return;
         const double count_bytes = static_cast<double>(costs_.bytes_per_point() - 1);
         const double p = static_cast<double>(buffered_points_);
-        if (io_) writer_.issue({p * count_bytes, p});
+        if (io_) writer_->issue({p * count_bytes, p});
         written_.insert(written_.end(), buffered_.begin(), buffered_.end());
         buffered_.clear();
         buffered_points_ = 0;
@@ -744,7 +744,7 @@ private:
 
     int rank_;
     const Costs& costs_;
-    WriterThread writer_;
+    std::optional<WriterThread> writer_;  // uncompressed only: an actor (and its stack) a rank
     const Options& options_;
     double flush_bytes_;
     double serve_every_;

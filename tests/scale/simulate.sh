@@ -151,15 +151,22 @@ mkdir -p "$out/lowres" "$out/costs" "$out/logs" "$out/ratio" "$out/jobs"
 tests/scale/build_sim_run.sh "$out/sim_run"
 # The platform: cluster.xml with the stresses' factors (tests/scale/stress_platform.py).
 platform=$out/platform$stress.xml
+# Beyond 4096 ranks, the same cluster with as many nodes as the most ranks need.
+most=$(tr ' ' '\n' <<<"$ranks" | sort -n | tail -1)
+nodes=$(( most > 4096 ? (most + 1023) / 1024 * 32 : 128 ))
+((nodes == 128)) || platform=$out/platform$stress.n$nodes.xml
 /usr/bin/python3 tests/scale/stress_platform.py tests/scale/cluster.xml "$platform" "$latency_factor" "$bandwidth_factor" \
-  "$fs_bandwidth_factor" "$metadata_factor"
+  "$fs_bandwidth_factor" "$metadata_factor" "$nodes"
 # The cluster of cluster.xml: 32 ranks a node, consecutive ranks on one node.
-for ((i = 0; i < 128; i++)); do echo "node-$i:32"; done >"$out/hosts"
+for ((i = 0; i < nodes; i++)); do echo "node-$i:32"; done >"$out/hosts.$nodes"
 
 # shellcheck source=calibration.env
 source tests/scale/calibration.env
+# Stacks of 512 KiB for the simulated ranks (SimGrid's default 8 MiB: 1024 ranks of
+# corner_zoom --weak 8 took 1.3 GB of memory, 0.8 GB with these; nothing in sim_run goes deep).
 smpi=(--cfg=smpi/host-speed:1Gf --cfg=smpi/simulate-computation:no --cfg=smpi/privatization:no
-      --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536)
+      --cfg=smpi/iprobe:0 --cfg=smpi/test:0 --cfg=smpi/grow-injected-times:no --cfg=smpi/async-small-thresh:65536
+      --cfg=contexts/stack-size:512)
 
 for job in "${jobs[@]}"; do
   name=$(basename "$job" .toml)
@@ -265,8 +272,9 @@ EOF
     serve_every=$(field ideal_s | /usr/bin/python3 -c 'import sys; print(max(0.05, float(sys.stdin.read()) / 2000))')
     # 4. The simulated run.
     start=$SECONDS
-    sim() {  # COSTS [more sim_run options]
-      smpirun -np "$n" -platform "$platform" -hostfile "$out/hosts" "$out/sim_run" "$1" \
+    sim() {  # COSTS [more sim_run options]; the simulator's own time and memory in the log
+      /usr/bin/time -a -o "$log" -f "simulate: the simulator took %e s of wall time and %M KiB of memory at most" \
+        smpirun -np "$n" -platform "$platform" -hostfile "$out/hosts.$nodes" "$out/sim_run" "$1" \
         --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" "${write[@]}" \
         ${startup:+--startup-seconds "$startup"} "${stress_args[@]}" "${@:2}" "${smpi[@]}" >>"$log" 2>&1
     }

@@ -4,7 +4,11 @@ the network's latencies and bandwidths, the file system's bandwidths (its disk's
 client's) and its cost per operation (the latency of every operation, and the time the
 metadata server takes for each of its own) multiplied by the given factors.
 
-    platform.py CLUSTER.xml OUT.xml LATENCY_FACTOR BANDWIDTH_FACTOR FS_BANDWIDTH_FACTOR METADATA_FACTOR
+    platform.py CLUSTER.xml OUT.xml LATENCY_FACTOR BANDWIDTH_FACTOR FS_BANDWIDTH_FACTOR METADATA_FACTOR [NODES]
+
+NODES above the cluster's 128 (a multiple of 32): that many nodes, in leaves of 32 under 8
+core switches with 4 cables from each leaf to each (the same full bisection: 32 cables up
+from 32 nodes).
 """
 import re
 import sys
@@ -15,7 +19,13 @@ UNITS = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
 def main():
     src, dst = sys.argv[1], sys.argv[2]
     lat, bw, fsbw, meta = (float(x) for x in sys.argv[3:7])
+    nodes = int(sys.argv[7]) if len(sys.argv) > 7 else 128
     x = open(src).read()
+    if nodes > 128:
+        if nodes % 32:
+            sys.exit(f"stress_platform: {nodes} nodes: a multiple of 32 above 128")
+        x = re.sub(r'radical="0-127"', f'radical="0-{nodes - 1}"', x)
+        x = re.sub(r'topo_parameters="[^"]*"', f'topo_parameters="2;32,{nodes // 32};1,8;1,4"', x)
 
     def rate(f):
         return lambda m: f'{m.group(1)}"{float(m.group(2)) * UNITS[m.group(3)] * f:.6g}Bps"'
