@@ -182,6 +182,8 @@ public:
     std::vector<AppendedTile> flush();
     // Some tile added has not been returned written yet.
     bool holding() const;
+    // More bytes wait for file space than one buffer holds.
+    bool full() const { return waiting_bytes_ > capacity_; }
     // The next tile's address alone: the end of the data.
     std::uint64_t end() const { return space_.empty() ? 0 : space_.back().at; }
     // Bytes of granted space left unused: range ends too short for the next tile.

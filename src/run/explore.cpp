@@ -403,6 +403,7 @@ public:
     void grant(std::uint64_t address, std::uint64_t bytes) override { appender_.grant(address, bytes); }
     std::vector<AppendedTile> written() override { return appender_.written(); }
     bool holding() const override { return appender_.holding(); }
+    bool full() const override { return appender_.full(); }
 
 private:
     ChunkAppender appender_;

@@ -437,6 +437,7 @@ private:
                 send_up(0);
             }
         }
+        wait_for_space();
         const std::vector<AppendedTile> placed = sink_->written();
         if (placed.empty()) return;
         outbox_.insert(outbox_.end(), {static_cast<std::uint64_t>(world_rank_), static_cast<std::uint64_t>(Group::placed),
@@ -447,6 +448,22 @@ private:
         }
         ++outbox_groups_;
         stats.tiles_placed += placed.size();
+    }
+
+    // A full sink waits for the file space it asked for, handling only its server's messages
+    // meanwhile (not the ranks' it serves: their tiles are what it has no room for).
+    void wait_for_space()
+    {
+        if (waiting_for_space_ || !space_asked_ || !sink_->full()) return;
+        waiting_for_space_ = true;
+        const double since = links_.now();
+        std::array<std::uint64_t, down_words> msg{};
+        while (space_asked_ && sink_->full()) {
+            links_.receive_down(msg, true);
+            on_down(msg);
+        }
+        stats.space_wait_seconds += links_.now() - since;
+        waiting_for_space_ = false;
     }
 
     void send_aside(bool last)
@@ -1007,6 +1024,7 @@ private:
     int aside_to_ = -1;
     int aside_sources_ = 0;
     bool space_asked_ = false;        // a request for file space is on its way
+    bool waiting_for_space_ = false;  // in wait_for_space()
     std::uint64_t want_ = 0;          // file space asked for in the next message up
     std::vector<std::uint64_t> aside_;  // groups for aside_to_
     std::uint64_t aside_groups_ = 0;

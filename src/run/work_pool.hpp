@@ -107,6 +107,10 @@ public:
     virtual std::vector<AppendedTile> written() = 0;
     // Some tile added has not been returned by written() yet.
     virtual bool holding() const = 0;
+    // It holds more tiles waiting for file space than it would write at once: the pool takes
+    // no more until rank 0's answer comes (its node's ranks then wait to send, as they would
+    // for a writer that is busy), so that a burst of reports cannot grow it without bound.
+    virtual bool full() const = 0;
 };
 
 // File space for a writer that asked for `bytes`: its address and size (rounded up to the
@@ -189,6 +193,7 @@ struct ScheduleStats {
     bool writer = false;             // this rank was one of them
     std::uint64_t tiles_placed = 0;  // tiles it wrote as a writer other than rank 0
     std::uint64_t grants = 0;        // file space it asked rank 0 for (rank 0: granted), times
+    double space_wait_seconds = 0;   // a writer's time waiting for file space with a full sink
     bool leader = false;             // this rank served a node (rank 0 included)
     bool computed = false;           // this rank computed tiles (false: a scheduler only)
 };

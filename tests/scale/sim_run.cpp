@@ -569,6 +569,7 @@ public:
         return out;
     }
     bool holding() const override { return !waiting_.empty() || appender.holding(); }
+    bool full() const override { return waiting_bytes_ > o_.append_bytes; }
 
     Appender appender;
     double copy_s = 0;
@@ -1067,7 +1068,7 @@ int run(int argc, char** argv)
     const std::vector<double> maxs =
         reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start,
                 r.stats.computed ? tiles_here : 0.0, sink_bytes, sink_held_back, sink_peak_ingress, mem.total(),
-                rank != 0 ? mem.total() : 0.0, fs.metadata_wait},
+                rank != 0 ? mem.total() : 0.0, fs.metadata_wait, r.stats.space_wait_seconds},
                MPI_MAX);
     const std::vector<double> sums = reduce({static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
                                              r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes,
@@ -1080,6 +1081,7 @@ int run(int argc, char** argv)
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
         const double writer_bytes_max = maxs[4], writer_held_back = maxs[5], writer_peak_ingress = maxs[6];
         const double rank_mib = maxs[7] / (1 << 20), other_mib = maxs[8] / (1 << 20), metadata_wait = maxs[9];
+        const double space_wait = maxs[10];
         const double ops = sums[0], given_back = sums[1], idle = sums[2], payload = sums[3], computing = sums[4],
                      write_calls = sums[5], bytes_written = sums[6], by_writers = sums[7], writers_copy = sums[8];
         const double tiles_min = mins[1], tiles_max = maxs[3];
@@ -1095,7 +1097,8 @@ int run(int argc, char** argv)
                     "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g checkpoint_s=%.6g computing_ranks=%.0f tiles_min=%.0f "
                     "tiles_max=%.0f write_calls=%.0f bytes_written=%.0f writers=%d written_by_writers=%.6g "
                     "writer_bytes_max=%.6g writer_held_back_max_s=%.6g writer_peak_ingress_bytes_per_s=%.6g writers_copy_s=%.6g "
-                    "root_grants=%llu metadata_wait_max_s=%.6g rank_mib=%.1f root_mib=%.1f other_rank_mib=%.1f\n",
+                    "root_grants=%llu metadata_wait_max_s=%.6g writer_space_wait_max_s=%.6g rank_mib=%.1f root_mib=%.1f "
+                    "other_rank_mib=%.1f\n",
                     ranks, ideal / (scheduled - start), ideal / end_to_end, end_to_end, ideal, total, schedule_s, startup,
                     start - t0 - restart_s, restart_s, end - finish_start, end - scheduled, last_busy - first_idle,
                     static_cast<unsigned long long>(costs.tiles()), static_cast<unsigned long long>(r.stats.requests_in),
@@ -1104,7 +1107,8 @@ int run(int argc, char** argv)
                     static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writes, writer_busy,
                     backlog, held_back, peak_ingress, copy_s, checkpoint_s, computing, tiles_min, tiles_max, write_calls,
                     bytes_written, writer_count, by_writers, writer_bytes_max, writer_held_back, writer_peak_ingress, writers_copy,
-                    static_cast<unsigned long long>(root_grants), metadata_wait, rank_mib, mem.total() / (1 << 20), other_mib);
+                    static_cast<unsigned long long>(root_grants), metadata_wait, space_wait, rank_mib, mem.total() / (1 << 20),
+                    other_mib);
         std::fflush(stdout);
     }
     return 0;

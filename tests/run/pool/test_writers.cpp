@@ -125,6 +125,8 @@ public:
         return out;
     }
     bool holding() const override { return !waiting_.empty() || !writing_.empty(); }
+    // More than 20 tiles wait for space (the test's tiles are 100-460 bytes).
+    bool full() const override { return waiting_.size() > 20; }
 
     static constexpr std::uint64_t ahead = 256;
 
@@ -275,6 +277,10 @@ TEST(Writers, EveryTileWrittenOnceByAsManyWritersAsAsked)
                                                                     [](const auto& w) { return w.second != 0; })));
         if (expected > 1) {
             EXPECT_GT(rec.results[0].stats.grants, 0u);
+            // A rank's second of tiles comes at once: a writer whose sink filled waited for its space.
+            double waited = 0;
+            for (const PoolResult& r : rec.results) waited += r.stats.space_wait_seconds;
+            EXPECT_GT(waited, 0.0) << asked << " writers asked";
         }
     }
 }
