@@ -312,10 +312,8 @@ std::size_t ChunkAppender::place(const TileBatch& batch, std::size_t next, std::
 {
     const auto size = [&](std::size_t i) { return batch.entries[TileBatch::words * i + 2] + batch.entries[TileBatch::words * i + 3]; };
     while (next < batch.tiles()) {
-        while (!space_.empty() && space_.front().end - space_.front().at < size(next)) {
-            skipped_ += space_.front().end - space_.front().at;
-            space_.pop_front();
-        }
+        // A range's end too short for the next tile stays unused (a hole in the file).
+        while (!space_.empty() && space_.front().end - space_.front().at < size(next)) space_.pop_front();
         if (space_.empty()) break;
         Range& r = space_.front();
         // One write is one run of the file: a range apart from the buffer's starts another.

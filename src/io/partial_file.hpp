@@ -184,10 +184,6 @@ public:
     bool holding() const;
     // More bytes wait for file space than one buffer holds.
     bool full() const { return waiting_bytes_ > capacity_; }
-    // The next tile's address alone: the end of the data.
-    std::uint64_t end() const { return space_.empty() ? 0 : space_.back().at; }
-    // Bytes of granted space left unused: range ends too short for the next tile.
-    std::uint64_t skipped() const { return skipped_; }
 
 private:
     struct Buffer {
@@ -216,7 +212,6 @@ private:
     TileBatch waiting_;  // tiles with no space yet, from waiting_next_ (data from waiting_at_)
     std::size_t waiting_next_ = 0, waiting_at_ = 0;
     std::uint64_t waiting_bytes_ = 0;
-    std::uint64_t skipped_ = 0;
     Buffer buffers_[2];
     int current_ = 0;
     std::vector<AppendedTile> written_;
