@@ -189,10 +189,8 @@ const PosixFile& PartialFile::file() const
 std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
                                                 std::span<const StoredChunk> stored)
 {
-    // Contiguous shares: runs of consecutive tiles are read in one piece.
-    const auto ranks = static_cast<std::uint64_t>(comm_ ? comm_->size() : 1);
-    const auto rank = static_cast<std::uint64_t>(comm_ ? comm_->rank() : 0);
-    const std::uint64_t begin = done.size() * rank / ranks, end = done.size() * (rank + 1) / ranks;
+    // Runs of consecutive tiles are read in one piece.
+    const std::uint64_t begin = 0, end = done.size();
     std::vector<std::uint64_t> bad;
     std::vector<std::byte> counts, outcomes;
     if (layout_.compressed) {

@@ -89,9 +89,10 @@ public:
     // Opens the file on first use (std::system_error naming it if it cannot).
     const PosixFile& file() const;
 
-    // Collective: of the tiles `done` (identical on every rank, ascending) with the
-    // checksums recorded for them (and, compressed, where they lie), those whose data no
-    // longer match, on every rank. Each rank reads its share (one process: all).
+    // Collective: of the tiles `done` with the checksums recorded for them (and,
+    // compressed, where they lie), those whose data no longer match, on every rank. Each rank
+    // gives its share of the done tiles, ascending, the shares in rank order (one process:
+    // all of them).
     std::vector<std::uint64_t> damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
                                        std::span<const StoredChunk> stored);
 

@@ -589,51 +589,72 @@ StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, 
     return started;
 }
 
-// The tiles done (from rank 0's journal, on every rank) and those left to compute. A resume
-// first checks that the done tiles still hold what was written: every rank checks some.
+// The tiles left to compute, on every rank, and how many are done (rank 0's journal). A
+// resume first checks that the done tiles still hold what was written: each rank checks a
+// share, and is sent only its share's checksums and places (every rank holding all of them,
+// 40 bytes a done tile, was the most memory a rank of a resume at thousands of ranks took:
+// tests/scale/README.md).
 struct TilesLeft {
-    std::vector<std::uint64_t> done;
     std::vector<std::uint64_t> pending;
+    std::uint64_t done = 0;
+    std::uint64_t points_done = 0;
 };
 
 TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& partial, PlanMode mode,
                      const TileJournal& journal, const PartialLayout& layout, const Tiling& tiling)
 {
+    // The done flags, a bit a tile.
+    std::vector<std::uint64_t> bits;
+    if (comm.is_root()) {
+        bits.assign((journal.done.size() + 63) / 64, 0);
+        for (std::uint64_t t = 0; t < journal.done.size(); ++t) bits[t / 64] |= std::uint64_t{journal.done[t] != 0} << (t % 64);
+    }
+    comm.broadcast(bits);
+    const auto is_done = [&](std::uint64_t t) { return ((bits[t / 64] >> (t % 64)) & 1u) != 0; };
     TilesLeft left;
-    for (std::uint64_t t = 0; t < journal.done.size(); ++t) {
-        if (journal.done[t] != 0) left.done.push_back(t);
-    }
-    comm.broadcast(left.done);
-    if (mode == PlanMode::resume) {
-        std::vector<std::uint64_t> sums, where;  // of the done tiles: rank 0 read them
-        if (comm.is_root()) {
-            for (const std::uint64_t t : left.done) {
-                sums.push_back(journal.checksums[t]);
-                if (layout.compressed) {
-                    const StoredChunk& c = journal.stored[t];
-                    where.insert(where.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
-                }
-            }
-        }
-        comm.broadcast(sums);
-        comm.broadcast(where);
-        std::vector<StoredChunk> stored(where.size() / 3);
-        for (std::size_t i = 0; i < stored.size(); ++i) stored[i] = {where[3 * i], where[3 * i + 1], where[3 * i + 2]};
-        if (const std::vector<std::uint64_t> bad = file.damaged(left.done, sums, stored); !bad.empty()) {
-            file.close();
-            throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
-                                         "checksum written with them; refusing to resume onto it: --overwrite to start "
-                                         "again, or --output to write elsewhere",
-                                         partial.string(), bad.size(), left.done.size(), bad.front()));
-        }
-    }
-    std::uint64_t d = 0;
     for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-        if (d < left.done.size() && left.done[d] == t) {
-            ++d;
+        if (is_done(t)) {
+            ++left.done;
+            left.points_done += tiling.box(t).points();
         } else {
             left.pending.push_back(t);
         }
+    }
+    if (mode != PlanMode::resume) return left;
+    // Rank r checks the done tiles [n r / P, n (r + 1) / P) of the n in order.
+    const auto ranks = static_cast<std::uint64_t>(comm.size());
+    const auto share_begin = [&](std::uint64_t r) { return left.done * r / ranks; };
+    std::vector<int> counts(ranks), triples(ranks);
+    for (std::uint64_t r = 0; r < ranks; ++r) {
+        counts[r] = static_cast<int>(share_begin(r + 1) - share_begin(r));
+        triples[r] = layout.compressed ? 3 * counts[r] : 0;
+    }
+    std::vector<std::uint64_t> sums, where;  // of every done tile, in order: rank 0 read them
+    if (comm.is_root()) {
+        for (std::uint64_t t = 0; t < journal.done.size(); ++t) {
+            if (journal.done[t] == 0) continue;
+            sums.push_back(journal.checksums[t]);
+            if (layout.compressed) {
+                const StoredChunk& c = journal.stored[t];
+                where.insert(where.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
+            }
+        }
+    }
+    const std::vector<std::uint64_t> my_sums = comm.scatter(sums, counts);
+    const std::vector<std::uint64_t> my_where = comm.scatter(where, triples);
+    std::vector<std::uint64_t> mine;  // this rank's share of the done tiles
+    const std::uint64_t first = share_begin(static_cast<std::uint64_t>(comm.rank())), last = first + my_sums.size();
+    for (std::uint64_t t = 0, i = 0; t < tiling.tiles() && i < last; ++t) {
+        if (is_done(t) && i++ >= first) mine.push_back(t);
+    }
+    std::vector<StoredChunk> stored(my_where.size() / 3);
+    for (std::size_t i = 0; i < stored.size(); ++i) stored[i] = {my_where[3 * i], my_where[3 * i + 1], my_where[3 * i + 2]};
+    if (const std::vector<std::uint64_t> bad = file.damaged(mine, my_sums, stored); !bad.empty()) {
+        file.close();
+        throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
+                                     "checksum written with them; refusing to resume onto it: --overwrite to start "
+                                     "again, or --output to write elsewhere",
+                                     partial.string(), bad.size(), left.done, bad.front()));
     }
     return left;
 }
@@ -795,9 +816,9 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const int writers = layout.compressed ? schedule_writers(comm, schedule) : 1;
     std::optional<Recorder> recorder;
     if (comm.is_root()) {
-        RunStart run_start{plan.output, join_notes(plan.note, writers_note(schedule.writers, writers, layout)),
-                           comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(), left.done.size(), 0};
-        for (const std::uint64_t t : left.done) run_start.points_done += tiling.box(t).points();
+        const RunStart run_start{plan.output, join_notes(plan.note, writers_note(schedule.writers, writers, layout)),
+                                 comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(), left.done,
+                                 left.points_done};
         observer.started(run_start);
         recorder.emplace(file, partial, std::move(start.journal), job, layout, tiling, observer, writers);
     }

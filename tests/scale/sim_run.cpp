@@ -759,8 +759,9 @@ private:
 };
 
 // The modelled memory of a rank beyond its counting's own buffers (explore's, bytes): the
-// hand-out list every rank holds (8 bytes a pending tile); a resume's done tiles with their
-// checksums and places, broadcast to every rank for the check (40 bytes a done tile); on
+// hand-out list every rank holds (8 bytes a pending tile); a resume's done flags (a bit a
+// tile) and the rank's share of the done tiles' checksums and places (40 bytes each: tile,
+// checksum, place), rank 0 all of them (32 bytes a done tile) before it sends them; on
 // rank 0 the journal (TileJournal: a flag, a checksum and a place, 33 bytes a tile), its
 // appender's two buffers and the largest message it takes; a rank's compressed tiles
 // before it sends them and their packed copy; a writer's waiting tiles, buffers and the
@@ -802,11 +803,12 @@ int run(int argc, char** argv)
     // compressed, 14 KB and 35 bytes a tile in 16 write calls, measured as
     // Options::create_writes was; 9 bytes a tile uncompressed). A resume (--resumed): rank 0
     // looks for an undo log, opens the partial file with HDF5 and reads its journal (33 bytes
-    // a tile); the done tiles, their checksums and places (40 bytes a done tile) are
-    // broadcast to every rank (charged as a scatter and an allgather, van de Geijn's large
-    // broadcast: 2 B / link bandwidth, plus a latency per level of the tree); each rank
-    // opens the file, reads its share of the done tiles one pread each through its client
-    // and hashes them (--hash-gbps), and the ranks gather what they found. Then the ranks
+    // a tile); the done flags, a bit a tile, are broadcast to every rank (charged as a
+    // scatter and an allgather, van de Geijn's large broadcast: 2 B / link bandwidth, plus a
+    // latency per level of the tree), and each rank is sent its share of the done tiles'
+    // checksums and places (32 bytes a done tile, all of them leaving rank 0's link); each
+    // rank opens the file, reads its share of the done tiles one pread each through its
+    // client and hashes them (--hash-gbps), and the ranks gather what they found. Then the ranks
     // that write open the file (POSIX: a rank opens it when it first uses it; uncompressed,
     // every rank writes).
     const double journal_bytes_per_tile = o.compressed ? 35.0 : 9.0;
@@ -835,8 +837,10 @@ int run(int argc, char** argv)
             }
         }
         world.barrier();
-        const double bcast = std::ceil(std::log2(std::max(2, ranks))) * 2e-6 + 2 * 40 * done_tiles / 12.5e9;
-        simgrid::s4u::this_actor::sleep_for(bcast);
+        const double levels = std::ceil(std::log2(std::max(2, ranks)));
+        const double bcast = levels * 2e-6 + 2 * (tiles / 8) / 12.5e9;
+        const double scatter = levels * 2e-6 + 32 * done_tiles / 12.5e9;
+        simgrid::s4u::this_actor::sleep_for(bcast + scatter);
         const auto n = static_cast<std::uint64_t>(done.size());
         const std::uint64_t begin = n * static_cast<std::uint64_t>(rank) / static_cast<std::uint64_t>(ranks);
         const std::uint64_t end = n * static_cast<std::uint64_t>(rank + 1) / static_cast<std::uint64_t>(ranks);
@@ -1047,7 +1051,7 @@ int run(int argc, char** argv)
     // The memory model (Memory above), this rank's.
     Memory mem;
     mem.list = 8 * pending;
-    mem.resume = o.resumed ? 40 * done_tiles : 0.0;
+    mem.resume = o.resumed ? tiles / 8 + 40 * done_tiles / ranks + (rank == 0 ? 32 * done_tiles : 0.0) : 0.0;
     mem.journal = rank == 0 ? 33 * tiles : 0.0;
     const double message = 8 << 20;  // the largest message a server takes: a leader's 8 MiB of its node's
     mem.buffers = 2 * work.max_batch_bytes;

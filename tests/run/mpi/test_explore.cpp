@@ -251,7 +251,7 @@ TEST(RunExplore, ManyWritersWriteTheSameResult)
             EXPECT_EQ(tally.start.note.find("writers asked") != std::string::npos, capped) << tally.start.note;
         }
         s.output = dir / ("w" + std::to_string(writers) + "-resumed.h5");
-        expect_stopped_and_resumed(job, s, want, 5);
+        expect_stopped_and_resumed(job, s, want, 10);
     }
 }
 
