@@ -64,6 +64,19 @@ def descendants(pid):
     return found
 
 
+def rank_of(pid):
+    """MPI rank of a process started by mpirun (Open MPI puts it in the environment); None
+    for another process."""
+    try:
+        with open(f"/proc/{pid}/environ", "rb") as f:
+            for item in f.read().split(b"\0"):
+                if item.startswith(b"OMPI_COMM_WORLD_RANK="):
+                    return int(item.split(b"=", 1)[1])
+    except OSError:
+        pass
+    return None
+
+
 def capped_job(max_bounces, n_xi=2, n_W=2, tile_points=None):
     """A job in which every point bounces to the cap: around the marginally stable
     self-retracing motion (0.25, -0.5, -1.25) of the dissipation-free model. The resume

@@ -19,7 +19,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import descendants, killable_job, mpi_env, running_journal, wall_impacts_per_second  # noqa: E402
+from superball_testing import (descendants, killable_job, mpi_env, rank_of, running_journal,  # noqa: E402
+                               wall_impacts_per_second)
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
@@ -44,19 +45,6 @@ alignment = 4096
 def datasets(path):
     with h5py.File(path, "r") as f:
         return f["wall_bounces"][()], f["outcome"][()]
-
-
-def rank_of(pid):
-    """The MPI rank of an Open MPI process, from its environment; None for mpirun's own."""
-    try:
-        with open(f"/proc/{pid}/environ", "rb") as f:
-            env = f.read().split(b"\0")
-    except OSError:
-        return None
-    for entry in env:
-        if entry.startswith(b"OMPI_COMM_WORLD_RANK="):
-            return int(entry.split(b"=", 1)[1])
-    return None
 
 
 class Writers(unittest.TestCase):

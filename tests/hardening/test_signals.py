@@ -36,8 +36,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import (capped_job, descendants, killable_job, mpi_env, read_partial, running_journal,  # noqa: E402
-                               superball_binary, tile_boxes, wall_impacts_per_second)
+from superball_testing import (capped_job, descendants, killable_job, mpi_env, rank_of, read_partial,  # noqa: E402
+                               running_journal, superball_binary, tile_boxes, wall_impacts_per_second)
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
@@ -47,18 +47,6 @@ MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 # (capped_job, 8 tiles of 100 capped points) about a second a tile.
 MEDIUM_SECONDS = 4.0
 TILE_SECONDS = 1.0
-
-
-def rank_of(pid):
-    """MPI rank of a process started by mpirun (Open MPI puts it in the environment)."""
-    try:
-        with open(f"/proc/{pid}/environ", "rb") as f:
-            for item in f.read().split(b"\0"):
-                if item.startswith(b"OMPI_COMM_WORLD_RANK="):
-                    return int(item.split(b"=", 1)[1])
-    except OSError:
-        pass
-    return None
 
 
 def alive(pid):

@@ -20,6 +20,13 @@ def value(v):
     return repr(v)
 
 
+def write_tables(job, f, gap=""):
+    """The job's [model], [grid] and [run] tables as TOML into `f`, `gap` before each."""
+    for table in ("model", "grid", "run"):
+        if table in job:
+            f.write(f"{gap}[{table}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in job[table].items()))
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("job")
@@ -47,11 +54,7 @@ def main():
     job["run"] = run
     with open(a.out, "w") as f:
         f.write(f"# Lower-resolution sample of {a.job} for the scaling simulation (tests/scale/lowres_job.py).\n")
-        for table in ("model", "grid", "run"):
-            if table in job:
-                f.write(f"\n[{table}]\n")
-                for k, v in job[table].items():
-                    f.write(f"{k} = {value(v)}\n")
+        write_tables(job, f, gap="\n")
 
 
 if __name__ == "__main__":

@@ -176,7 +176,7 @@ for job in "${jobs[@]}"; do
     /usr/bin/python3 - "$job" "$out/jobs/$name.weak$weak.toml" "$weak" <<'EOF'
 import sys, tomllib
 sys.path.insert(0, "tests/scale")
-from lowres_job import value
+from lowres_job import write_tables
 job = tomllib.load(open(sys.argv[1], "rb"))
 f = int(sys.argv[3])
 axes = [k for k, v in job["grid"].items() if isinstance(v, dict)]
@@ -184,10 +184,7 @@ longest = max(axes, key=lambda k: job["grid"][k]["n"])
 job["grid"][longest]["n"] *= f
 if "tile_points" in job.get("run", {}):
     job["run"]["tile_points"] *= f
-with open(sys.argv[2], "w") as out:
-    for t in ("model", "grid", "run"):
-        if t in job:
-            out.write(f"[{t}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in job[t].items()))
+write_tables(job, open(sys.argv[2], "w"))
 EOF
     job=$out/jobs/$name.weak$weak.toml
     name=$name.weak$weak
@@ -197,13 +194,10 @@ EOF
     /usr/bin/python3 - "$job" "$out/jobs/$name.tp$tile_points.toml" "$tile_points" <<'EOF'
 import sys, tomllib
 sys.path.insert(0, "tests/scale")
-from lowres_job import value
+from lowres_job import write_tables
 job = tomllib.load(open(sys.argv[1], "rb"))
 job.setdefault("run", {})["tile_points"] = int(sys.argv[3])
-with open(sys.argv[2], "w") as f:
-    for t in ("model", "grid", "run"):
-        if t in job:
-            f.write(f"[{t}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in job[t].items()))
+write_tables(job, open(sys.argv[2], "w"))
 EOF
     job=$out/jobs/$name.tp$tile_points.toml
     label=$name.tp$tile_points$stress
