@@ -115,6 +115,26 @@ max_bounces = 4294967295
     EXPECT_EQ(job.max_bounces, 4294967295u);
 }
 
+// [run] writers: a count or "auto" (0), the default; the same words as explore --writers.
+TEST(Job, Writers)
+{
+    const auto writers_of = [](const std::string& run) {
+        return parse_job(model_section + "[grid]\nxi = { min = 0, max = 1, n = 4 }\nU = -1\nW = 0\n" + run, source).writers;
+    };
+    EXPECT_EQ(writers_of(""), 0u);
+    EXPECT_EQ(writers_of("[run]\nwriters = \"auto\"\n"), 0u);
+    EXPECT_EQ(writers_of("[run]\nwriters = 128\n"), 128u);
+    EXPECT_EQ(writers_from_text("auto", "--writers"), 0u);
+    EXPECT_EQ(writers_from_text("4", "--writers"), 4u);
+    for (const char* bad : {"0", "-1", "4x", "", "65537", "many"}) {
+        EXPECT_THROW(writers_from_text(bad, "--writers"), InputError) << bad;
+    }
+    // Who writes changes no count: not part of the fingerprint.
+    EXPECT_EQ(fingerprint(parse_job(model_section + "[grid]\nxi = { min = 0, max = 1, n = 4 }\nU = -1\nW = 0\n", source)),
+              fingerprint(parse_job(model_section + "[grid]\nxi = { min = 0, max = 1, n = 4 }\nU = -1\nW = 0\n[run]\nwriters = 8\n",
+                                    source)));
+}
+
 TEST(Job, PhysicalWithDefaultFrame)
 {
     const std::string text = model_section + R"(
@@ -328,6 +348,11 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"OutputNotString", canonical_job(xi_range + fixed_u_w, "[run]\noutput = 5\n"),
                   {"[run] output = 5", "expected a string"}},
         ErrorCase{"OutputEmpty", canonical_job(xi_range + fixed_u_w, "[run]\noutput = \"\"\n"), {"[run] output", "empty"}},
+        ErrorCase{"WritersZero", canonical_job(xi_range + fixed_u_w, "[run]\nwriters = 0\n"),
+                  {"[run] writers = 0 is out of range", "\"auto\" or a count of writers from 1 to 65536"}},
+        ErrorCase{"WritersWord", canonical_job(xi_range + fixed_u_w, "[run]\nwriters = \"all\"\n"),
+                  {"[run] writers = \"all\"", "\"auto\" or a count"}},
+        ErrorCase{"WritersFloat", canonical_job(xi_range + fixed_u_w, "[run]\nwriters = 4.0\n"), {"[run] writers", "integer"}},
         ErrorCase{"TilePointsZero", canonical_job(xi_range + fixed_u_w, "[run]\ntile_points = 0\n"),
                   {"[run] tile_points = 0", "1 <= tile_points <= 16777216"}},
         ErrorCase{"TilePointsTooLarge", canonical_job(xi_range + fixed_u_w, "[run]\ntile_points = 16777217\n"),
