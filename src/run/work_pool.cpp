@@ -397,9 +397,13 @@ private:
             return;
         }
         std::vector<std::uint64_t>& box = aside_to_ >= 0 && !f.payload.empty() ? aside_ : outbox_;
-        box.insert(box.end(), {static_cast<std::uint64_t>(world_rank_), static_cast<std::uint64_t>(Group::reported),
-                               f.reports.size()});
-        for (const TileReport& r : f.reports) box.insert(box.end(), {r.tile, r.checksum});
+        box.push_back(static_cast<std::uint64_t>(world_rank_));
+        box.push_back(static_cast<std::uint64_t>(Group::reported));
+        box.push_back(f.reports.size());
+        for (const TileReport& r : f.reports) {
+            box.push_back(r.tile);
+            box.push_back(r.checksum);
+        }
         box.push_back(f.payload.size());
         const std::size_t at = box.size();
         box.resize(at + (f.payload.size() + 7) / 8, 0);
