@@ -1,7 +1,9 @@
 """Helpers shared by the Python end-to-end tests: where the binary is, the environment
 mpirun needs, the processes below mpirun, and how fast the binary under test is."""
 import os
+import shutil
 import subprocess
+import tempfile
 import unittest
 
 SOURCE = os.environ.get("SUPERBALL_SOURCE_DIR") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -42,6 +44,37 @@ def mpi_env():
     if os.geteuid() == 0:
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     return env
+
+
+class ExploreCase(unittest.TestCase):
+    """A test with a directory of its own that runs `superball explore` under mpirun
+    ($SUPERBALL and $MPIEXEC, as ctest sets them)."""
+    prefix = "superball-"
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix=self.prefix)
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def path(self, name):
+        return os.path.join(self.dir, name)
+
+    def write_job(self, text, name="job.toml"):
+        with open(self.path(name), "w") as f:
+            f.write(text)
+        return self.path(name)
+
+    def explore(self, job, output, ranks=1, extra=(), expect=0, wrap=()):
+        """`mpirun -n RANKS superball explore JOB -o OUTPUT -q EXTRA`, under `wrap` (a
+        command that runs the rest) if given; fails the test on another exit status."""
+        superball = os.environ.get("SUPERBALL", "superball")
+        mpiexec = os.environ.get("MPIEXEC") or "mpirun"
+        cmd = [*wrap, mpiexec, "-n", str(ranks), "--oversubscribe", superball, "explore", job, "-o", output, "-q",
+               *extra]
+        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=300)
+        self.assertEqual(r.returncode, expect, f"{' '.join(cmd)}\nstdout:\n{r.stdout}\nstderr:\n{r.stderr}")
+        return r
 
 
 def descendants(pid):

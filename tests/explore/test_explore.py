@@ -19,7 +19,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import descendants, killable_job, mpi_env, running_journal, wall_impacts_per_second  # noqa: E402
+from superball_testing import (ExploreCase, descendants, killable_job, mpi_env, running_journal,  # noqa: E402
+                               wall_impacts_per_second)
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
@@ -37,26 +38,8 @@ def job_text(grid, model="e = 0.9\nalpha = 0.9", run="max_bounces = 1000"):
 CANONICAL_2D = 'xi = { min = 0.0, max = 1.0, n = 61 }\nU = -1.0\nW = { min = -3.0, max = 3.0, n = 47 }'
 
 
-class Explore(unittest.TestCase):
-    def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="superball-explore-")
-
-    def tearDown(self):
-        shutil.rmtree(self.dir, ignore_errors=True)
-
-    def path(self, name):
-        return os.path.join(self.dir, name)
-
-    def write_job(self, text, name="job.toml"):
-        with open(self.path(name), "w") as f:
-            f.write(text)
-        return self.path(name)
-
-    def explore(self, job, output, ranks=1, extra=(), expect=0):
-        cmd = [MPIEXEC, "-n", str(ranks), "--oversubscribe", SUPERBALL, "explore", job, "-o", output, "-q", *extra]
-        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=300)
-        self.assertEqual(r.returncode, expect, f"{' '.join(cmd)}\nstdout:\n{r.stdout}\nstderr:\n{r.stderr}")
-        return r
+class Explore(ExploreCase):
+    prefix = "superball-explore-"
 
     @staticmethod
     def datasets(path):

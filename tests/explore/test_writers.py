@@ -10,16 +10,14 @@ import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
-import unittest
 
 import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import (descendants, killable_job, mpi_env, rank_of, running_journal,  # noqa: E402
+from superball_testing import (ExploreCase, descendants, killable_job, mpi_env, rank_of, running_journal,  # noqa: E402
                                wall_impacts_per_second)
 
 SUPERBALL = os.environ.get("SUPERBALL", "superball")
@@ -47,26 +45,8 @@ def datasets(path):
         return f["wall_bounces"][()], f["outcome"][()]
 
 
-class Writers(unittest.TestCase):
-    def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="superball-writers-")
-
-    def tearDown(self):
-        shutil.rmtree(self.dir, ignore_errors=True)
-
-    def path(self, name):
-        return os.path.join(self.dir, name)
-
-    def write_job(self, text, name="job.toml"):
-        with open(self.path(name), "w") as f:
-            f.write(text)
-        return self.path(name)
-
-    def explore(self, job, output, ranks, extra=(), expect=0, wrap=()):
-        cmd = [*wrap, MPIEXEC, "-n", str(ranks), "--oversubscribe", SUPERBALL, "explore", job, "-o", output, "-q", *extra]
-        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=300)
-        self.assertEqual(r.returncode, expect, f"{' '.join(cmd)}\nstdout:\n{r.stdout}\nstderr:\n{r.stderr}")
-        return r
+class Writers(ExploreCase):
+    prefix = "superball-writers-"
 
     def assert_same(self, a, b):
         for x, y in zip(datasets(a), datasets(b)):

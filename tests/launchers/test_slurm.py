@@ -50,7 +50,9 @@ output = "out/tiny.h5"
 # (wall_impacts_per_second) so that two ranks take about `seconds`, spread over 64 tiles of a
 # fraction of a second each (a stop request is honoured quickly). A fixed max_bounces made the
 # job last 4 s with one kernel and 0.5 s with the AVX-512 one, too short to be stopped twice.
-def slow_job(speed, seconds=5.0):
+# 8 s: with 5 s, on a loaded machine (ctest -j2 beside other work, 2026-11-28), the first stop
+# landed with 43 of the 64 tiles done, and the resubmitted run's 21 finished before the second.
+def slow_job(speed, seconds=8.0):
     points = 256 * 256
     max_bounces = max(1000, int(2 * seconds * speed / points))
     return f"""\
