@@ -10,6 +10,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 import h5py
@@ -47,6 +48,25 @@ def datasets(path):
 
 class Writers(ExploreCase):
     prefix = "superball-writers-"
+    killable = None  # (job, its uninterrupted result), made once for both kill tests
+
+    @classmethod
+    def tearDownClass(cls):
+        if cls.killable is not None:
+            shutil.rmtree(os.path.dirname(cls.killable[0]), ignore_errors=True)
+
+    def killable_and_straight(self):
+        """A job of about 2.5 s on 2 ranks and its result left alone, made on first use: the
+        binary's speed measured and the straight run made once, not once a kill test."""
+        if Writers.killable is None:
+            shared = tempfile.mkdtemp(prefix="superball-writers-shared-")
+            job = os.path.join(shared, "kill.toml")
+            with open(job, "w") as f:
+                f.write(killable_job(wall_impacts_per_second(SUPERBALL, shared), 2.5))
+            straight = os.path.join(shared, "straight.h5")
+            self.explore(job, straight, 2)
+            Writers.killable = (job, straight)
+        return Writers.killable
 
     def assert_same(self, a, b):
         for x, y in zip(datasets(a), datasets(b)):
@@ -101,7 +121,7 @@ class Writers(ExploreCase):
     def kill_mid_run(self, rank):
         """A run of 8 ranks, 4 writers, killed (SIGKILL to rank `rank`) once a fifth of its
         tiles are recorded; --resume then equals a run left alone."""
-        job = self.write_job(killable_job(wall_impacts_per_second(SUPERBALL, self.dir), 2.5), f"kill{rank}.toml")
+        job, straight = self.killable_and_straight()
         out = self.path(f"killed{rank}.h5")
         partial = out + ".partial"
         flags = ["--node-ranks", "2", "--writers", "4"]
@@ -127,8 +147,6 @@ class Writers(ExploreCase):
             self.assertLess(int(f["progress/tile_done"][()].sum()), f["progress/tile_done"].size)
         self.explore(job, out, 8, ["--resume", *flags])
         self.assertFalse(os.path.exists(partial))
-        straight = self.path(f"straight{rank}.h5")
-        self.explore(job, straight, 2)
         self.assert_same(out, straight)
 
     def test_writer_killed_then_resumed(self):
