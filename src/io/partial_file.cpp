@@ -189,13 +189,11 @@ const PosixFile& PartialFile::file() const
 std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
                                                 std::span<const StoredChunk> stored)
 {
-    // Runs of consecutive tiles are read in one piece.
-    const std::uint64_t begin = 0, end = done.size();
     std::vector<std::uint64_t> bad;
     std::vector<std::byte> counts, outcomes;
     if (layout_.compressed) {
         const std::uint64_t size = file().size();
-        for (std::uint64_t i = begin; i < end; ++i) {
+        for (std::uint64_t i = 0; i < done.size(); ++i) {
             const StoredChunk& s = stored[i];
             if (s.end() > size || s.end() < s.address) {
                 bad.push_back(done[i]);
@@ -209,10 +207,12 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
             }
         }
     } else {
+        // Runs of consecutive tiles are read in one piece.
         const std::uint64_t cb = layout_.counts_chunk(), ob = layout_.outcomes_chunk();
         constexpr std::uint64_t max_run = std::uint64_t{8} << 20;
         const std::uint64_t run_tiles = std::max<std::uint64_t>(1, max_run / cb);
-        for (std::uint64_t i = begin; i < end;) {
+        const std::uint64_t end = done.size();
+        for (std::uint64_t i = 0; i < end;) {
             std::uint64_t n = 1;
             while (i + n < end && n < run_tiles && done[i + n] == done[i] + n) ++n;
             counts.resize(n * cb);

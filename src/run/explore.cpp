@@ -589,7 +589,8 @@ StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, 
     return started;
 }
 
-// The tiles left to compute, on every rank, and how many are done (rank 0's journal). A
+// The tiles left to compute and how many are done, on every rank, and their points on rank
+// 0, which reports them (from rank 0's journal). A
 // resume first checks that the done tiles still hold what was written: each rank checks a
 // share, and is sent only its share's checksums and places (every rank holding all of them,
 // 40 bytes a done tile, was the most memory a rank of a resume at thousands of ranks took:
@@ -597,7 +598,7 @@ StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, 
 struct TilesLeft {
     std::vector<std::uint64_t> pending;
     std::uint64_t done = 0;
-    std::uint64_t points_done = 0;
+    std::uint64_t points_done = 0;  // on rank 0
 };
 
 TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& partial, PlanMode mode,
@@ -615,7 +616,7 @@ TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& p
     for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
         if (is_done(t)) {
             ++left.done;
-            left.points_done += tiling.box(t).points();
+            if (comm.is_root()) left.points_done += tiling.box(t).points();
         } else {
             left.pending.push_back(t);
         }
