@@ -303,6 +303,27 @@ OwnedComm OwnedComm::split_shared(const Comm& c, int key)
     return OwnedComm(out);
 }
 
+OwnedComm OwnedComm::range(const Comm& c, int first, int last, int stride, int tag)
+{
+    // The two groups are freed here whatever happens: a group owns nothing the new
+    // communicator needs (MPI-3.1, 6.3.2), and these are their only uses.
+    struct Group {
+        MPI_Group g = MPI_GROUP_NULL;
+        ~Group()
+        {
+            if (g != MPI_GROUP_NULL) MPI_Group_free(&g);
+        }
+    };
+    Group all;
+    check(MPI_Comm_group(c.get(), &all.g), "MPI_Comm_group");
+    int triple[1][3] = {{first, last, stride}};
+    Group part;
+    check(MPI_Group_range_incl(all.g, 1, triple, &part.g), "MPI_Group_range_incl");
+    MPI_Comm out = MPI_COMM_NULL;
+    check(MPI_Comm_create_group(c.get(), part.g, tag, &out), "MPI_Comm_create_group");
+    return OwnedComm(out);
+}
+
 OwnedComm OwnedComm::dup(const Comm& c)
 {
     MPI_Comm out = MPI_COMM_NULL;

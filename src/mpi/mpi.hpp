@@ -136,6 +136,10 @@ public:
     // MPI_Comm_split_type(MPI_COMM_TYPE_SHARED): the ranks that share this rank's memory
     // (its node), ordered by `key`.
     static OwnedComm split_shared(const Comm& c, int key);
+    // MPI_Comm_create_group over the ranks first, first + stride, ... up to last of `c`:
+    // collective over those ranks only (a split is collective over all of `c`), so each
+    // rank must call it for the group it belongs to, with the same `tag` per group.
+    static OwnedComm range(const Comm& c, int first, int last, int stride, int tag);
     static OwnedComm dup(const Comm& c);
 
     bool null() const { return comm_ == MPI_COMM_NULL; }

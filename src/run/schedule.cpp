@@ -14,6 +14,9 @@ constexpr int tag_up = 21;
 constexpr int tag_down = 22;
 // Aside: a node leader to the leader that writes its node's tiles, on the leaders'.
 constexpr int tag_aside = 23;
+// MPI_Comm_create_group's tags for the nodes' and the leaders' communicators.
+constexpr int tag_node_group = 24;
+constexpr int tag_leaders_group = 25;
 
 // Which ranks serve which: the node (every rank of `comm` when one level is enough) and
 // the node leaders, rank 0 first.
@@ -28,17 +31,35 @@ Topology make_topology(const mpi::Comm& comm, const ScheduleSettings& s)
 {
     Topology t;
     const int rank = comm.rank();
-    // Key = rank: rank 0 leads its node, and every node's ranks keep their order.
-    t.node = s.node_ranks > 0 ? mpi::OwnedComm::split(comm, rank / s.node_ranks, rank)
-                              : mpi::OwnedComm::split_shared(comm, rank);
-    const mpi::Comm node = t.node.view();
-    const std::uint64_t nodes = comm.sum({node.rank() == 0 ? 1u : 0u})[0];
-    const double biggest = comm.max(static_cast<double>(node.size()));
+    const int size = comm.size();
+    const int per_node = s.node_ranks;
+    int nodes = 0;
+    int biggest = 0;
+    if (per_node > 0) {
+        // Pseudo-nodes are runs of consecutive ranks, so every rank knows its node, the
+        // node count and the leaders without a message: each communicator is made by its
+        // own ranks alone. (A split gathers every rank's colour at rank 0, which SMPI
+        // simulates at a cost growing as the square of the ranks: 16384 ranks never left it.)
+        const int first = rank / per_node * per_node;
+        t.node = mpi::OwnedComm::range(comm, first, std::min(first + per_node, size) - 1, 1, tag_node_group);
+        nodes = (size + per_node - 1) / per_node;
+        biggest = std::min(per_node, size);
+    } else {
+        // Key = rank: rank 0 leads its node, and every node's ranks keep their order.
+        t.node = mpi::OwnedComm::split_shared(comm, rank);
+        nodes = static_cast<int>(comm.sum({t.node.view().rank() == 0 ? 1u : 0u})[0]);
+        biggest = static_cast<int>(comm.max(static_cast<double>(t.node.view().size())));
+    }
     // One rank per node gains nothing from a leader: every rank is then served by rank 0.
     t.two_level = nodes > 1 && biggest > 1;
-    t.nodes = t.two_level ? static_cast<int>(nodes) : 1;
+    t.nodes = t.two_level ? nodes : 1;
     if (!t.two_level) t.node = mpi::OwnedComm::dup(comm);
-    t.leaders = mpi::OwnedComm::split(comm, t.node.view().rank() == 0 ? 0 : MPI_UNDEFINED, rank);
+    const bool leads = t.node.view().rank() == 0;
+    if (per_node == 0)
+        t.leaders = mpi::OwnedComm::split(comm, leads ? 0 : MPI_UNDEFINED, rank);
+    else if (leads)
+        t.leaders = t.two_level ? mpi::OwnedComm::range(comm, 0, size - 1, per_node, tag_leaders_group)
+                                : mpi::OwnedComm::range(comm, 0, 0, 1, tag_leaders_group);
     return t;
 }
 

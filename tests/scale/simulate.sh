@@ -25,7 +25,7 @@
 #                           [--out DIR] [--no-build]
 #                           [--latency-factor F] [--bandwidth-factor F] [--fs-bandwidth-factor F]
 #                           [--metadata-factor F] [--noise SIGMA] [--slow-nodes FRACTION:SPEED]
-#                           [--lose-node] [--requeue-seconds S]
+#                           [--lose-node] [--requeue-seconds S] [--collectives auto|default|trees]
 #                           [JOB.toml...]
 #
 # --weak F: the job scaled up, its longest grid axis F times as many samples, its tiles F
@@ -53,6 +53,15 @@
 # until the loss, then the resumed run (efficiency: the resumed run's compute phase). A
 # stressed run's logs are NAME.STRESS.N.log.
 #
+# --collectives: SMPI's algorithms for the collectives (MPI_Allreduce, MPI_Reduce,
+# MPI_Barrier, MPI_Gather, MPI_Scatter; the schedule itself is point to point). SMPI's
+# default ones are linear, rank 0 waiting on a request from every rank at once, which costs
+# the simulator a time growing as the square of the ranks (at 16384 ranks one allreduce had
+# not ended after 40 min); "trees" selects logarithmic ones of Open MPI's (recursive
+# doubling for allreduce and barrier, binomial trees for the others), as the real program
+# gets from Open MPI. (SMPI's whole "ompi" selector is not used: its broadcast sets up
+# SMPI's per-node communicators and aborted sim_run.) auto (the default): "default" up to
+# 4096 ranks (the results of README.md here were measured with it), "trees" beyond.
 # Default: every job of jobs/cluster, OUT = build/scale. --tile-points: run the jobs in tiles
 # of T points whatever they or the default say (the logs are then NAME.tpT.N.log).
 # --sample-points P: the low-resolution sample of step 1 at about P points instead of 2.2
@@ -104,6 +113,7 @@ stress_args=()
 stress=
 lose_node=false
 requeue=420
+collectives=auto
 jobs=()
 while (($# > 0)); do
   case $1 in
@@ -122,14 +132,19 @@ while (($# > 0)); do
     --slow-nodes) stress_args+=(--slow-nodes "$2"); stress+=.slow${2/:/x}; shift 2 ;;
     --lose-node) lose_node=true; stress+=.lost; shift ;;
     --requeue-seconds) requeue=$2; shift 2 ;;
+    --collectives) collectives=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --no-build) build=false; shift ;;
     -h|--help) sed -n '2,100p' "$0"; exit 0 ;;
-    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --weak, --writers, --ratio-boxes, --sample-points, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --help)" >&2; exit 2 ;;
+    -*) echo "simulate: unknown option $1 (accepted: --ranks, --startup-seconds, --tile-points, --weak, --writers, --ratio-boxes, --sample-points, --out, --no-build, --latency-factor, --bandwidth-factor, --fs-bandwidth-factor, --metadata-factor, --noise, --slow-nodes, --lose-node, --requeue-seconds, --collectives, --help)" >&2; exit 2 ;;
     *) jobs+=("$1"); shift ;;
   esac
 done
 ((${#jobs[@]} > 0)) || jobs=(jobs/cluster/*.toml)
+case $collectives in
+  auto|default|trees) ;;
+  *) echo "simulate: --collectives $collectives: accepted auto, default or trees" >&2; exit 2 ;;
+esac
 [[ $weak =~ ^[1-9][0-9]*$ ]] || { echo "simulate: --weak $weak: accepted a whole factor >= 1" >&2; exit 2; }
 case $writers in
   auto) writers_arg=0 ;;
@@ -210,6 +225,8 @@ EOF
     lowname=$name.sp$sample_points
     label=$label.sp$sample_points
   fi
+  # Tree collectives asked for at every rank count: lines of their own.
+  if [[ $collectives == trees ]]; then label=$label.trees; fi
   "$superball" explore "$job" --dry-run >/dev/null
   # 1. The low-resolution sample, computed again only when the job changed (tile_points
   #    and output aside: lowres_job.py leaves them out). The candidate's name holds this
@@ -266,11 +283,16 @@ EOF
     serve_every=$(field ideal_s | /usr/bin/python3 -c 'import sys; print(max(0.05, float(sys.stdin.read()) / 2000))')
     # 4. The simulated run.
     start=$SECONDS
+    coll=()
+    if [[ $collectives == trees ]] || { [[ $collectives == auto ]] && ((n > 4096)); }; then
+      coll=(--cfg=smpi/allreduce:rdb --cfg=smpi/reduce:ompi_binomial --cfg=smpi/barrier:ompi_recursivedoubling
+            --cfg=smpi/gather:ompi_binomial --cfg=smpi/scatter:ompi_binomial --cfg=smpi/bcast:binomial_tree)
+    fi
     sim() {  # COSTS [more sim_run options]; the simulator's own time and memory in the log
       /usr/bin/time -a -o "$log" -f "simulate: the simulator took %e s of wall time and %M KiB of memory at most" \
         smpirun -np "$n" -platform "$platform" -hostfile "$out/hosts.$nodes" "$out/sim_run" "$1" \
         --node-ranks 32 --idle-poll 0.02 --serve-every "$serve_every" --granule "$granule" "${write[@]}" \
-        ${startup:+--startup-seconds "$startup"} "${stress_args[@]}" "${@:2}" "${smpi[@]}" >>"$log" 2>&1
+        ${startup:+--startup-seconds "$startup"} "${stress_args[@]}" "${@:2}" "${smpi[@]}" "${coll[@]}" >>"$log" 2>&1
     }
     extra=
     if $lose_node; then

@@ -201,7 +201,7 @@ void expect_reported_once(const Outcome& r, const std::vector<std::uint64_t>& pe
 }
 
 // Rank 0 computes or only schedules; one level, or node leaders over pseudo-nodes of two
-// ranks (two levels from 3 ranks on).
+// ranks (two levels from 3 ranks on); pseudo-nodes of one rank each are one level again.
 struct Mode {
     const char* name;
     int dedicated_root_ranks;
@@ -220,7 +220,8 @@ class Schedule : public testing::TestWithParam<Mode> {};
 
 INSTANTIATE_TEST_SUITE_P(Modes, Schedule,
                          testing::Values(Mode{"one_level", 64, 0}, Mode{"dedicated_root", 2, 0},
-                                         Mode{"two_level", 64, 2}, Mode{"two_level_dedicated_root", 2, 2}),
+                                         Mode{"two_level", 64, 2}, Mode{"two_level_dedicated_root", 2, 2},
+                                         Mode{"one_rank_nodes", 64, 1}),
                          [](const testing::TestParamInfo<Mode>& i) { return std::string(i.param.name); });
 
 // Tiles left after an interrupted run: gaps of every size.
@@ -340,7 +341,8 @@ TEST_P(Schedule, StopOnTheLastRankEndsEveryRank)
 class ScheduleTimed : public Schedule {};
 
 INSTANTIATE_TEST_SUITE_P(Modes, ScheduleTimed,
-                         testing::Values(Mode{"one_level", 64, 0}, Mode{"two_level_dedicated_root", 2, 2}),
+                         testing::Values(Mode{"one_level", 64, 0}, Mode{"two_level_dedicated_root", 2, 2},
+                                         Mode{"one_rank_nodes", 64, 1}),
                          [](const testing::TestParamInfo<Mode>& i) { return std::string(i.param.name); });
 
 // Blocks of 150 tiles of 1 ms, reports every 20 ms: the journal hears of each tile soon
