@@ -590,8 +590,8 @@ StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, 
 }
 
 // The tiles left to compute and how many are done, on every rank, and their points on rank
-// 0, which reports them (from rank 0's journal). A
-// resume first checks that the done tiles still hold what was written: each rank checks a
+// 0, which reports them (from rank 0's journal). A resume first checks that the done tiles
+// still hold what was written: each rank checks a
 // share, and is sent only its share's checksums and places (every rank holding all of them,
 // 40 bytes a done tile, was the most memory a rank of a resume at thousands of ranks took:
 // tests/scale/README.md).

@@ -57,9 +57,8 @@ Topology make_topology(const mpi::Comm& comm, const ScheduleSettings& s)
     const bool leads = t.node.view().rank() == 0;
     if (per_node == 0)
         t.leaders = mpi::OwnedComm::split(comm, leads ? 0 : MPI_UNDEFINED, rank);
-    else if (leads)
-        t.leaders = t.two_level ? mpi::OwnedComm::range(comm, 0, size - 1, per_node, tag_leaders_group)
-                                : mpi::OwnedComm::range(comm, 0, 0, 1, tag_leaders_group);
+    else if (leads)  // every node's first rank; rank 0 alone on one level
+        t.leaders = mpi::OwnedComm::range(comm, 0, t.two_level ? size - 1 : 0, per_node, tag_leaders_group);
     return t;
 }
 

@@ -44,11 +44,15 @@ TEST(OwnedCommRange, AStrideMakesTheLeaders)
     EXPECT_EQ(leaders.view().broadcast(static_cast<std::int64_t>(world.rank() == 0 ? 41 : 0)), 41);
 }
 
-// A split and a copy give the ranks the same places as the ranges do.
+// A split by the same pseudo-nodes gives each rank the same node as the range; a copy of
+// the world the same places as the world.
 TEST(OwnedComm, SplitAndDupAgreeWithRanges)
 {
+    const int first = world.rank() / 2 * 2;
+    const mpi::OwnedComm range = mpi::OwnedComm::range(world, first, std::min(first + 2, world.size()) - 1, 1, 9);
     const mpi::OwnedComm split = mpi::OwnedComm::split(world, world.rank() / 2, world.rank());
-    EXPECT_EQ(split.view().rank(), world.rank() % 2);
+    EXPECT_EQ(split.view().rank(), range.view().rank());
+    EXPECT_EQ(split.view().size(), range.view().size());
     const mpi::OwnedComm copy = mpi::OwnedComm::dup(world);
     EXPECT_EQ(copy.view().rank(), world.rank());
     EXPECT_EQ(copy.view().size(), world.size());
