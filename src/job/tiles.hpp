@@ -122,6 +122,6 @@ inline constexpr int interleave_ranks_default = 64;
 // each in the first 3 s of a 40 s run; interleaved, 0.2 s: tests/scale). Bit-reversed, any
 // 2^k consecutive granules sample the whole grid evenly, so a block's cost follows its
 // size. Results never depend on the order.
-std::vector<std::uint64_t> handout_order(const std::vector<std::uint64_t>& pending, std::uint64_t granule, bool interleave);
+std::vector<std::uint64_t> handout_order(std::vector<std::uint64_t> pending, std::uint64_t granule, bool interleave);
 
 }  // namespace superball

@@ -850,9 +850,11 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
     // and the granule only groups tiles for the interleaved hand-out.
     schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    // Every rank holds the hand-out list through the run (8 bytes a tile): made in place
+    // from what is left, not beside it.
     const std::vector<std::uint64_t> pending =
-        handout_order(left.pending, schedule.granule, comm.size() >= settings.interleave_ranks);
-    left = {};  // every rank holds the hand-out list through the run (8 bytes a tile): once, not thrice
+        handout_order(std::move(left.pending), schedule.granule, comm.size() >= settings.interleave_ranks);
+    left = {};
     const auto compute_start = std::chrono::steady_clock::now();
     const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule, writing);
     const auto compute_end = std::chrono::steady_clock::now();

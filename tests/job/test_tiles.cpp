@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
+#include <random>
 #include <vector>
 
 #include "job/tiles.hpp"
@@ -70,6 +71,51 @@ TEST(HandoutOrder, EveryTileOnceAndIncompleteGranulesLast)
     const std::vector<std::uint64_t> tail(order.begin() + static_cast<std::ptrdiff_t>(whole), order.end());
     const std::vector<std::uint64_t> expected{16, 19, 20, 21, 22, 23, 56, 57, 58, 59, 61, 62, 63, 96, 97, 98, 99, 100, 101, 102};
     EXPECT_EQ(tail, expected);
+}
+
+// The order as job/tiles.hpp states it, built the plain way: runs of a granule's pending
+// tiles, whole ones by bit-reversed granule number, then the incomplete ones in grid order.
+std::vector<std::uint64_t> order_as_stated(const std::vector<std::uint64_t>& pending, std::uint64_t granule)
+{
+    std::vector<std::vector<std::uint64_t>> runs;
+    for (const std::uint64_t t : pending) {
+        if (runs.empty() || runs.back().back() / granule != t / granule) runs.emplace_back();
+        runs.back().push_back(t);
+    }
+    const std::uint64_t last = pending.back() / granule;
+    int bits = 0;
+    while ((std::uint64_t{1} << bits) <= last) ++bits;
+    const auto reversed = [bits](std::uint64_t g) {
+        std::uint64_t r = 0;
+        for (int b = 0; b < bits; ++b) r = (r << 1) | ((g >> b) & 1u);
+        return r;
+    };
+    const auto whole = [granule](const std::vector<std::uint64_t>& r) { return r.size() == granule; };
+    std::stable_sort(runs.begin(), runs.end(), [&](const auto& a, const auto& b) {
+        if (whole(a) != whole(b)) return whole(a);
+        return whole(a) && reversed(a.front() / granule) < reversed(b.front() / granule);
+    });
+    std::vector<std::uint64_t> order;
+    for (const auto& r : runs) order.insert(order.end(), r.begin(), r.end());
+    return order;
+}
+
+TEST(HandoutOrder, AsStatedForRandomResumesAndGranules)
+{
+    // Resumes with a random fifth of the tiles done, grids that are and are not a power of
+    // two of granules, granules of 1 (compressed files) to 16.
+    std::mt19937_64 random(32);
+    for (const std::uint64_t granule : {1u, 2u, 3u, 8u, 16u}) {
+        for (const std::uint64_t tiles : {1u, 7u, 64u, 1000u, 4099u}) {
+            std::vector<std::uint64_t> pending;
+            for (std::uint64_t t = 0; t < tiles; ++t) {
+                if (random() % 5 != 0) pending.push_back(t);
+            }
+            if (pending.empty()) continue;
+            EXPECT_EQ(handout_order(pending, granule, true), order_as_stated(pending, granule))
+                << tiles << " tiles, granule " << granule;
+        }
+    }
 }
 
 // Tiles are the result's chunks: large on a workstation (the file's size), many per rank
