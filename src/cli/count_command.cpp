@@ -10,9 +10,9 @@ namespace superball::cli {
 
 int count_command(const CountOptions& opt)
 {
-    const Model model = resolve_model(opt.model, flag_spelling);
+    const OneStartSetup setup = resolve_one_start(opt.model, opt.start, opt.max_bounces, flag_spelling);
     const Start start = resolve_start(opt.start);
-    const BounceCount r = count(start.canonical, model, opt.max_bounces);
+    const BounceCount r = count(start.canonical, setup.model, setup.max_bounces);
     if (opt.json) {
         fmt::print("{}", count_json(r, start.canonical));
     } else {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "core/input.hpp"
 
@@ -13,7 +14,7 @@ namespace superball::cli {
 struct CountOptions {
     ModelInput model;
     StartInput start;
-    std::uint32_t max_bounces = 1000;
+    std::string max_bounces = "1000";  // as given: resolve_max_bounces checks it
     bool json = false;
 };
 

@@ -114,15 +114,17 @@ void add_start_flags(CLI::App& app, StartInput& in)
     app.add_option("--radius", in.radius, "ball radius a [m] (default 0.025)")->group(physical);
 }
 
-void add_max_bounces_flag(CLI::App& app, std::uint32_t& max_bounces)
+// Taken as text and checked by the library (resolve_max_bounces), as Python's count is, so
+// that both refuse a bad limit in the same words.
+void add_max_bounces_flag(CLI::App& app, std::string& max_bounces)
 {
-    app.add_option("--max-bounces", max_bounces, "stop after this many wall impacts (outcome capped)")
-        ->check(CLI::Range(std::uint32_t{1}, std::uint32_t{4294967295u}))
+    app.add_option("--max-bounces", max_bounces, "stop after this many wall impacts (outcome capped), 1 to 4294967295")
+        ->type_name("INT")
         ->capture_default_str();
 }
 
 // The flags of the commands that follow one start point (count, trajectory).
-void add_one_start_flags(CLI::App& app, ModelInput& model, StartInput& start, std::uint32_t& max_bounces)
+void add_one_start_flags(CLI::App& app, ModelInput& model, StartInput& start, std::string& max_bounces)
 {
     add_model_flags(app, model);
     add_start_flags(app, start);

@@ -25,10 +25,11 @@ void write_csv(std::FILE* f, const Trajectory& tr, double radius)
 
 int trajectory_command(const TrajectoryOptions& opt)
 {
-    const Model model = resolve_model(opt.model, flag_spelling);
+    const OneStartSetup setup = resolve_one_start(opt.model, opt.start, opt.max_bounces, flag_spelling);
+    const Model& model = setup.model;
     const Start start = resolve_start(opt.start);
     if (opt.samples == 1) throw InputError("--samples = 1 is out of range: accepted 0 or 2..100000");
-    const Trajectory tr = trajectory(start.state, model, start.frame.g, opt.max_bounces, opt.samples);
+    const Trajectory tr = trajectory(start.state, model, start.frame.g, setup.max_bounces, opt.samples);
     write_output(opt.output, [&](std::FILE* f) {
         if (opt.format == "json") {
             fmt::print(f, "{}", trajectory_json(tr, start, model));

@@ -14,7 +14,7 @@ namespace superball::cli {
 struct TrajectoryOptions {
     ModelInput model;
     StartInput start;
-    std::uint32_t max_bounces = 1000;
+    std::string max_bounces = "1000";  // as given: resolve_max_bounces checks it
     std::string format = "csv";
     int samples = 0;
     std::string output;

@@ -1,5 +1,6 @@
 #include "input.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -54,11 +55,10 @@ double pick(const std::optional<double>& specific, const std::optional<double>& 
     return value;
 }
 
-double require(const std::optional<double>& value, std::string_view key, std::string_view kind, const KeySpelling& spell)
+double finite(double value, std::string_view key, const KeySpelling& spell)
 {
-    if (!value) throw InputError(spell(key) + " is not set: a " + std::string(kind) + " start needs it");
-    if (!std::isfinite(*value)) throw InputError(spell(key) + " = " + format_double(*value) + " is not a finite number");
-    return *value;
+    if (!std::isfinite(value)) throw InputError(spell(key) + " = " + format_double(value) + " is not a finite number");
+    return value;
 }
 
 void check_launch(bool ok, std::string_view key, double value, std::string_view accepted, const KeySpelling& spell)
@@ -78,7 +78,7 @@ Model resolve_model(const ModelInput& in, const KeySpelling& spell)
              pick(in.alpha_floor, in.alpha, "alpha_floor", "alpha", false, spell)}};
 }
 
-Start resolve_start(const StartInput& in, const KeySpelling& spell)
+StartKind resolve_start_keys(const StartInput& in, const KeySpelling& spell)
 {
     const auto keys = [&](std::initializer_list<std::string_view> names) {
         std::string out;
@@ -99,31 +99,76 @@ Start resolve_start(const StartInput& in, const KeySpelling& spell)
     if (!any_canonical && !any_physical) {
         throw InputError("no start point: give " + canonical + " (canonical) or " + physical + " (physical)");
     }
-    Start s;
+    const auto require = [&](const std::optional<double>& value, std::string_view key, std::string_view kind) {
+        if (!value) throw InputError(spell(key) + " is not set: a " + std::string(kind) + " start needs it");
+    };
+    StartKind k;
     if (any_canonical) {
         if (in.g || in.radius) throw InputError(spell("g") + " and " + spell("radius") + " apply to physical starts only");
-        s.canonical = {require(in.xi, "xi", "canonical", spell), require(in.U, "U", "canonical", spell),
-                       require(in.W, "W", "canonical", spell)};
+        require(in.xi, "xi", "canonical");
+        require(in.U, "U", "canonical");
+        require(in.W, "W", "canonical");
+        return k;
+    }
+    k.physical = true;
+    k.frame = Frame{};
+    k.frame.g = in.g.value_or(k.frame.g);
+    k.frame.radius = in.radius.value_or(k.frame.radius);
+    if (!(std::isfinite(k.frame.g) && k.frame.g > 0.0))
+        throw InputError(spell("g") + " = " + format_double(k.frame.g) + " is out of range: accepted g > 0");
+    if (!(std::isfinite(k.frame.radius) && k.frame.radius > 0.0))
+        throw InputError(spell("radius") + " = " + format_double(k.frame.radius) + " is out of range: accepted radius > 0");
+    require(in.omega, "omega", "physical");
+    require(in.x, "x", "physical");
+    require(in.u, "u", "physical");
+    require(in.v, "v", "physical");
+    return k;
+}
+
+Start resolve_start(const StartInput& in, const KeySpelling& spell)
+{
+    const StartKind kind = resolve_start_keys(in, spell);
+    Start s;
+    s.physical = kind.physical;
+    s.frame = kind.frame;
+    if (!kind.physical) {
+        s.canonical = {finite(*in.xi, "xi", spell), finite(*in.U, "U", spell), finite(*in.W, "W", spell)};
         check_launch(s.canonical.xi > 0.0, "xi", s.canonical.xi, "xi > 0 (xi >= 1 misses the wall)", spell);
         check_launch(s.canonical.U < 0.0, "U", s.canonical.U, "U < 0", spell);
-        s.frame = {1.0, 1.0};
         s.state = to_physical(s.canonical, 1.0, 1.0);
         return s;
     }
-    s.physical = true;
-    s.frame.g = in.g.value_or(s.frame.g);
-    s.frame.radius = in.radius.value_or(s.frame.radius);
-    if (!(std::isfinite(s.frame.g) && s.frame.g > 0.0))
-        throw InputError(spell("g") + " = " + format_double(s.frame.g) + " is out of range: accepted g > 0");
-    if (!(std::isfinite(s.frame.radius) && s.frame.radius > 0.0))
-        throw InputError(spell("radius") + " = " + format_double(s.frame.radius) + " is out of range: accepted radius > 0");
-    const double omega = require(in.omega, "omega", "physical", spell);
-    s.state = {require(in.x, "x", "physical", spell), require(in.u, "u", "physical", spell),
-               require(in.v, "v", "physical", spell), omega * s.frame.radius};
+    const double omega = finite(*in.omega, "omega", spell);
+    s.state = {finite(*in.x, "x", spell), finite(*in.u, "u", spell), finite(*in.v, "v", spell), omega * s.frame.radius};
     check_launch(s.state.x > 0.0, "x", s.state.x, "x > 0", spell);
     check_launch(s.state.u < 0.0, "u", s.state.u, "u < 0", spell);
     check_launch(s.state.v > 0.0, "v", s.state.v, "v > 0", spell);
     s.canonical = to_canonical(s.state, s.frame.g);
+    return s;
+}
+
+std::uint32_t resolve_max_bounces(std::string_view given, const KeySpelling& spell)
+{
+    const bool negative = !given.empty() && given.front() == '-';
+    const std::string_view digits = negative ? given.substr(1) : given;
+    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        throw InputError(spell("max_bounces") + " = " + std::string(given) + " is not an integer");
+    }
+    std::uint64_t value = 0;
+    const bool fits = std::from_chars(digits.data(), digits.data() + digits.size(), value).ec == std::errc{};
+    if (negative || !fits || value < 1 || value > 4294967295u) {
+        throw InputError(spell("max_bounces") + " = " + std::string(given) + " is out of range: accepted 1 to 4294967295");
+    }
+    return static_cast<std::uint32_t>(value);
+}
+
+OneStartSetup resolve_one_start(const ModelInput& model, const StartInput& start, std::string_view max_bounces,
+                                const KeySpelling& spell)
+{
+    OneStartSetup s;
+    s.model = resolve_model(model, spell);
+    s.start = resolve_start_keys(start, spell);
+    s.max_bounces = resolve_max_bounces(max_bounces, spell);
     return s;
 }
 

@@ -3,6 +3,7 @@
 // so that both accept exactly the same things.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <stdexcept>
@@ -38,6 +39,19 @@ struct StartInput {
     std::optional<double> x, u, v, omega, g, radius;
 };
 
+// What a start's keys make it, before any value is read: canonical or physical, and the
+// frame (g and radius, their defaults applied; a canonical start's is g = radius = 1).
+struct StartKind {
+    bool physical = false;
+    Frame frame{1.0, 1.0};
+};
+
+// Throws InputError when the start is mixed, missing or incomplete (the first key not set,
+// in the order xi U W, or omega x u v), or its frame out of range. Reads only which keys are
+// set, so that an interface given arrays of starts (Python's count) refuses what the
+// command line refuses, in the same words.
+StartKind resolve_start_keys(const StartInput& in, const KeySpelling& spell);
+
 // A start point resolved. Canonical starts are also given as the physical representative
 // with v = 1 in units where g = 1 and radius = 1 (so omega = W).
 struct Start {
@@ -50,6 +64,20 @@ struct Start {
 // Throws InputError naming the key when the start is incomplete, mixed or not a launch
 // toward the wall.
 Start resolve_start(const StartInput& in, const KeySpelling& spell);
+
+// The bounce limit of a count or trajectory as given (a decimal integer, any size, any
+// sign): 1 to 4294967295, else InputError naming the key and the value.
+std::uint32_t resolve_max_bounces(std::string_view given, const KeySpelling& spell);
+
+// What count and trajectory check before anything is counted, in the order every interface
+// reports it: the coefficients, the start's keys, the bounce limit.
+struct OneStartSetup {
+    Model model;
+    StartKind start;
+    std::uint32_t max_bounces = 0;
+};
+OneStartSetup resolve_one_start(const ModelInput& model, const StartInput& start, std::string_view max_bounces,
+                                const KeySpelling& spell);
 
 // Shortest text that reads back as the same double (for messages and attributes).
 std::string format_double(double x);

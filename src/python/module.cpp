@@ -9,6 +9,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -184,8 +185,28 @@ void refuse_non_finite(const std::vector<CoordinateArray>& c, std::span<const st
     }
 }
 
-// count(): the package has broadcast the coordinates to one shape (NumPy views) and checked
-// the scalars' types. Returns (wall_bounces uint32, outcome uint8) of that shape.
+// resolve_one_start(): what count() and trajectory() check first, as the command line does
+// (core/input.hpp): `given` names the start's coordinates that are set (arrays or numbers:
+// only which ones matters here). Returns (physical, g, radius, max_bounces).
+py::tuple one_start(const std::vector<std::string>& given, std::optional<double> g, std::optional<double> radius,
+                    const std::string& max_bounces, const ModelInput& model)
+{
+    StartInput in;
+    in.g = g;
+    in.radius = radius;
+    std::optional<double>* const slots[] = {&in.xi, &in.U, &in.W, &in.x, &in.u, &in.v, &in.omega};
+    const std::string_view names[] = {"xi", "U", "W", "x", "u", "v", "omega"};
+    for (const std::string& name : given) {
+        const auto at = std::find(std::begin(names), std::end(names), name);
+        if (at == std::end(names)) throw std::invalid_argument("resolve_one_start: no coordinate " + name);
+        *slots[at - std::begin(names)] = 0.0;
+    }
+    const OneStartSetup s = resolve_one_start(model, in, max_bounces, python_key);
+    return py::make_tuple(s.start.physical, s.start.frame.g, s.start.frame.radius, s.max_bounces);
+}
+
+// count(): the package has checked the input (one_start), broadcast the coordinates to one
+// shape (NumPy views) and checked the scalars' types. Returns (wall_bounces uint32, outcome uint8) of that shape.
 py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coordinates, bool physical, double g,
                        double radius, std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall,
                        std::optional<double> alpha_wall, std::optional<double> e_floor, std::optional<double> alpha_floor,
@@ -193,10 +214,6 @@ py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coo
 {
     const Model model = resolve_model(model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor), python_key);
     const CountKernel k = kernel_of(kernel).count;
-    if (physical && !(std::isfinite(g) && g > 0.0)) throw InputError("g = " + format_double(g) + " is out of range: accepted g > 0");
-    if (physical && !(std::isfinite(radius) && radius > 0.0)) {
-        throw InputError("radius = " + format_double(radius) + " is out of range: accepted radius > 0");
-    }
     std::vector<CoordinateArray> c;
     for (const auto& [name, a] : coordinates) c.emplace_back(name, a);
     if (c.size() != (physical ? 4u : 3u)) throw std::invalid_argument("count: wrong number of coordinates");
@@ -398,6 +415,16 @@ PYBIND11_MODULE(_core, m)
     m.attr("outcomes") = py::tuple(py::cast(outcomes));
     m.attr("usable_cores") = usable_cores();
 
+    m.def(
+        "resolve_one_start",
+        [](const std::vector<std::string>& given, std::optional<double> g, std::optional<double> radius,
+           const std::string& max_bounces, std::optional<double> e, std::optional<double> alpha,
+           std::optional<double> e_wall, std::optional<double> alpha_wall, std::optional<double> e_floor,
+           std::optional<double> alpha_floor) {
+            return one_start(given, g, radius, max_bounces, model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor));
+        },
+        py::arg("given"), py::arg("g"), py::arg("radius"), py::arg("max_bounces"), py::arg("e"), py::arg("alpha"),
+        py::arg("e_wall"), py::arg("alpha_wall"), py::arg("e_floor"), py::arg("alpha_floor"));
     m.def("count", &count_arrays, py::arg("coordinates"), py::arg("physical"), py::arg("g"), py::arg("radius"), py::arg("e"),
           py::arg("alpha"), py::arg("e_wall"), py::arg("alpha_wall"), py::arg("e_floor"), py::arg("alpha_floor"),
           py::arg("max_bounces"), py::arg("threads"), py::arg("kernel"));

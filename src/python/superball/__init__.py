@@ -54,9 +54,6 @@ KERNELS = _core.kernel_report
 #: Outcome names, indexed by code (the result files' flag_meanings).
 OUTCOMES = tuple(_core.outcomes)
 
-_MAX_BOUNCES = 2**32 - 1
-
-
 class Outcome(enum.IntEnum):
     """How the motion of a launch ended; the value is the code stored in result files."""
 
@@ -107,12 +104,17 @@ def _real(name, value, optional=True):
     return float(value)
 
 
-def _integer(name, value, low, high, accepted):
+def _integral(name, value):
+    """An integer argument as an int (the library checks its range)."""
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{name} must be an integer, not {type(value).__name__} {value!r}")
-    value = int(value)
+    return int(value)
+
+
+def _integer(name, value, low, high, accepted):
+    value = _integral(name, value)
     if not low <= value <= high:
         raise ValueError(f"{name} = {value} is out of range: accepted {accepted}")
     return value
@@ -153,28 +155,14 @@ def _coordinate(name, value):
     raise TypeError(f"{name} must be real numbers (a number or an array), not an array of {a.dtype}")
 
 
-def _start(xi, U, W, x, u, v, omega, g, radius):
-    """(physical, {name: value}) of the start given, refusing mixed or incomplete starts."""
-    canonical = {"xi": xi, "U": U, "W": W}
-    physical = {"x": x, "u": u, "v": v, "omega": omega}
-    given_c = [k for k, val in canonical.items() if val is not None]
-    given_p = [k for k, val in physical.items() if val is not None]
-    if given_c and given_p:
-        raise ValueError(f"give either a canonical start (xi, U, W) or a physical one (x, u, v, omega), not both "
-                         f"(given: {', '.join(given_c + given_p)})")
-    if not given_c and not given_p:
-        raise ValueError("no start: give xi, U, W (canonical) or x, u, v, omega (physical)")
-    if given_c:
-        if g is not None or radius is not None:
-            raise ValueError("g and radius apply to physical starts (x, u, v, omega) only")
-        missing = [k for k, val in canonical.items() if val is None]
-        if missing:
-            raise ValueError(f"{missing[0]} is not set: a canonical start needs xi, U and W")
-        return False, canonical
-    missing = [k for k, val in physical.items() if val is None]
-    if missing:
-        raise ValueError(f"{missing[0]} is not set: a physical start needs x, u, v and omega")
-    return True, physical
+def _one_start(coordinates, g, radius, model, max_bounces):
+    """(physical, {name: value} of the start's coordinates, g, radius, max_bounces): the
+    library's checks of count and trajectory, in the command line's order and words."""
+    given = [name for name, value in coordinates.items() if value is not None]
+    physical, g, radius, max_bounces = _core.resolve_one_start(given, _real("g", g), _real("radius", radius),
+                                                              str(_integral("max_bounces", max_bounces)), **model)
+    names = ("x", "u", "v", "omega") if physical else ("xi", "U", "W")
+    return physical, {name: coordinates[name] for name in names}, g, radius, max_bounces
 
 
 def _call_text(function, positional, keywords):
@@ -230,12 +218,10 @@ def count(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None
     >>> superball.count(0.05, -1, -2, e=0.9, alpha=0.9)
     Counts(wall_bounces=8, outcome=Outcome.left)
     """
-    physical, start = _start(xi, U, W, x, u, v, omega, g, radius)
     model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor)
-    max_bounces = _integer("max_bounces", max_bounces, 1, _MAX_BOUNCES, f"1 to {_MAX_BOUNCES}")
+    physical, start, g, radius, max_bounces = _one_start(dict(xi=xi, U=U, W=W, x=x, u=u, v=v, omega=omega), g, radius,
+                                                         model, max_bounces)
     threads, kernel = _threads(threads), _kernel(kernel)
-    g = 9.81 if g is None else _real("g", g, optional=False)
-    radius = 0.025 if radius is None else _real("radius", radius, optional=False)
     arrays = {name: _coordinate(name, value) for name, value in start.items()}
     try:
         shape = np.broadcast_shapes(*(a.shape for a in arrays.values()))
@@ -271,10 +257,10 @@ def trajectory(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g
     Attributes: wall_bounces (total), outcome (an Outcome, equal to count()'s), truncated,
     units, g, radius, start (the canonical xi, U, W).
     """
-    physical, start = _start(xi, U, W, x, u, v, omega, g, radius)
-    values = {name: _real(name, value) for name, value in start.items()}
     model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor)
-    max_bounces = _integer("max_bounces", max_bounces, 1, _MAX_BOUNCES, f"1 to {_MAX_BOUNCES}")
+    _, start, _, _, max_bounces = _one_start(dict(xi=xi, U=U, W=W, x=x, u=u, v=v, omega=omega), g, radius, model,
+                                             max_bounces)
+    values = {name: _real(name, value) for name, value in start.items()}
     samples = _integer("samples", samples, 0, 100000, "0 or 2 to 100000")
     coordinates = dict(xi=None, U=None, W=None, x=None, u=None, v=None, omega=None)
     coordinates.update(values)

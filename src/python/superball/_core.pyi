@@ -12,6 +12,9 @@ kernel_report: str
 outcomes: tuple[str, ...]
 usable_cores: int
 
+def resolve_one_start(given: Sequence[str], g: Optional[float], radius: Optional[float], max_bounces: str,
+                      e: Optional[float], alpha: Optional[float], e_wall: Optional[float], alpha_wall: Optional[float],
+                      e_floor: Optional[float], alpha_floor: Optional[float]) -> tuple[bool, float, float, int]: ...
 def count(coordinates: Sequence[tuple[str, npt.NDArray[Any]]], physical: bool, g: float, radius: float,
           e: Optional[float], alpha: Optional[float], e_wall: Optional[float], alpha_wall: Optional[float],
           e_floor: Optional[float], alpha_floor: Optional[float], max_bounces: int, threads: int,
