@@ -26,6 +26,7 @@
 #include "job/provenance.hpp"
 #include "run/explore_work.hpp"
 #include "run/refine.hpp"
+#include "run/root_acts.hpp"
 #include "run/tile_counter.hpp"
 #include "superball/version.hpp"
 
@@ -570,20 +571,7 @@ StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, 
                                 const Grid& grid, const Provenance& provenance)
 {
     StartedPartial started;
-    std::int64_t failed = 0;
-    std::string failure;
-    if (comm.is_root()) {
-        try {
-            started = start_partial(partial, mode, job, grid, comm.size(), provenance);
-        } catch (const RunError& e) {
-            failed = 1;
-            failure = e.what();
-        }
-    }
-    if (comm.broadcast(failed) != 0) {
-        comm.broadcast(failure);
-        throw RunError(failure);
-    }
+    root_acts(comm, [&] { started = start_partial(partial, mode, job, grid, comm.size(), provenance); });
     comm.broadcast(started.tile_shape);
     broadcast(comm, started.layout);
     return started;
@@ -687,27 +675,23 @@ FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<R
                        const PartialLayout& layout, const Provenance& provenance, const ExplorePlan& plan,
                        double seconds_before, std::chrono::steady_clock::time_point started, RunObserver& observer)
 {
-    std::int64_t ok = 1;
-    std::string failure;
     FinishReport finish;
+    std::optional<Failure> failure;
     if (comm.is_root()) {
-        try {
+        failure = attempt([&] {
             if (interrupted) {
                 recorder->checkpoint();
             } else {
                 recorder->last();
             }
-        } catch (const std::exception& e) {
-            ok = 0;
-            failure = e.what();
-        }
+        });
     }
     // The run's figures, in the partial file (a stop) or the result (complete), by rank 0
     // alone once every rank has closed the file.
     file.close();
     comm.barrier();
-    if (comm.is_root() && ok == 1) {
-        try {
+    if (comm.is_root() && !failure) {
+        failure = attempt([&] {
             const double seconds = seconds_since(started);
             if (interrupted) {
                 record_partial_run(partial, seconds, provenance);
@@ -716,16 +700,13 @@ FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<R
                 finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout,
                                        recorder->journal().tiles(), {provenance, seconds_before + seconds, true});
             }
-        } catch (const std::exception& e) {
-            ok = 0;
-            failure = fmt::format("{} {} failed: {}", interrupted ? "recording the run in" : "finishing the result from",
-                                  partial.string(), e.what());
+        });
+        if (failure) {
+            failure->message = fmt::format("{} {} failed: {}", interrupted ? "recording the run in" : "finishing the result from",
+                                           partial.string(), failure->message);
         }
     }
-    if (comm.broadcast(ok) == 0) {
-        comm.broadcast(failure);
-        throw RunError(failure);
-    }
+    throw_everywhere(comm, failure);
     return finish;
 }
 
