@@ -3,7 +3,9 @@ superball._core, which CMake builds, as the rest of superball, for the interpret
 this file (-DPython_EXECUTABLE=sys.executable): a conda or venv interpreter gets a module
 built for it, not for the one CMake would find on its own.
 
-setuptools compiles nothing here: the extension is the CMake target superball_python (the
+A setup.py beside pyproject.toml because Debian 12's setuptools (66) cannot declare an
+extension module in pyproject.toml (that came in setuptools 74, experimental): without one
+the wheel would be tagged pure Python. setuptools compiles nothing here: the extension is the CMake target superball_python (the
 build's flags, its kernel variants, the libraries it links) and only its file is copied into
 the wheel. Environment:
     SUPERBALL_PIP_BUILD_DIR  the CMake build tree to use (default build/pip-<interpreter tag>:
