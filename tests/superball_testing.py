@@ -38,6 +38,15 @@ def superball_binary():
     raise unittest.SkipTest("no superball binary: set SUPERBALL")
 
 
+def cmake_cache_value(build, name):
+    """The value of `name` in the CMake cache of the build tree `build` ("" if unset)."""
+    with open(os.path.join(build, "CMakeCache.txt")) as f:
+        for line in f:
+            if line.startswith(name + ":"):
+                return line.split("=", 1)[1].strip()
+    return ""
+
+
 def mpi_env():
     """The environment for mpirun: Open MPI refuses to run as root unless told."""
     env = dict(os.environ)

@@ -13,7 +13,7 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import SOURCE, mpi_env  # noqa: E402
+from superball_testing import SOURCE, cmake_cache_value, mpi_env  # noqa: E402
 
 BUILD = os.environ.get("SUPERBALL_BUILD_DIR", "")
 PYTHON = os.environ.get("SUPERBALL_PYTHON", "/usr/bin/python3")
@@ -32,20 +32,12 @@ output = "results/installed.h5"
 """
 
 
-def cache_value(name):
-    with open(os.path.join(BUILD, "CMakeCache.txt")) as f:
-        for line in f:
-            if line.startswith(name + ":"):
-                return line.split("=", 1)[1].strip()
-    return ""
-
-
 class Installed(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         if not BUILD or not os.path.isfile(os.path.join(BUILD, "CMakeCache.txt")):
             raise unittest.SkipTest("SUPERBALL_BUILD_DIR names no build tree (ctest sets it)")
-        if cache_value("SUPERBALL_SANITIZE") == "ON":
+        if cmake_cache_value(BUILD, "SUPERBALL_SANITIZE") == "ON":
             # The sanitized program and module need the sanitizer's runtime preloaded: not
             # what is installed for users; the release stage tests the installation.
             raise unittest.SkipTest("a sanitized build is not installed for users")

@@ -13,24 +13,17 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from superball_testing import main as superball_testing_main  # noqa: E402
-from superball_testing import SOURCE, mpi_env  # noqa: E402
+from superball_testing import SOURCE, cmake_cache_value, mpi_env  # noqa: E402
 
 BUILD = os.environ.get("SUPERBALL_BUILD_DIR", "")
 PYTHON = os.environ.get("SUPERBALL_PYTHON", "/usr/bin/python3")
 
 
-def cache_value(name):
-    with open(os.path.join(BUILD, "CMakeCache.txt")) as f:
-        for line in f:
-            if line.startswith(name + ":"):
-                return line.split("=", 1)[1].strip()
-    return ""
-
-
 class PipInstall(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        if BUILD and os.path.isfile(os.path.join(BUILD, "CMakeCache.txt")) and cache_value("SUPERBALL_SANITIZE") == "ON":
+        built = BUILD and os.path.isfile(os.path.join(BUILD, "CMakeCache.txt"))
+        if built and cmake_cache_value(BUILD, "SUPERBALL_SANITIZE") == "ON":
             raise unittest.SkipTest("pip builds a release module; the sanitized stage does not install it")
         listed = subprocess.run(["git", "-C", SOURCE, "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
                                 capture_output=True)
