@@ -20,7 +20,9 @@ struct RunStart {
     std::uint64_t points_done = 0;
 };
 
-// Rank 0's view of a run; every call comes from rank 0's thread.
+// Rank 0's view of a run. Calls come one at a time: from rank 0's thread in a run over MPI
+// ranks (run_explore), from any of the counting threads in a run on threads
+// (run_explore_threads), so an observer keeps no thread-local state.
 class RunObserver {
 public:
     virtual ~RunObserver() = default;
