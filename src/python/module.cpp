@@ -206,7 +206,8 @@ py::tuple one_start(const std::vector<std::string>& given, std::optional<double>
 }
 
 // count(): the package has checked the input (one_start), broadcast the coordinates to one
-// shape (NumPy views) and checked the scalars' types. Returns (wall_bounces uint32, outcome uint8) of that shape.
+// shape (NumPy views) and checked the scalars' types. Returns (wall_bounces uint32,
+// outcome uint8) of that shape.
 py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coordinates, bool physical, double g,
                        double radius, std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall,
                        std::optional<double> alpha_wall, std::optional<double> e_floor, std::optional<double> alpha_floor,
