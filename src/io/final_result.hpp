@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 
 #include "job/tiles.hpp"
@@ -26,12 +27,14 @@ struct FinishReport {
     std::string sidecar_note;      // "sidecar: PATH", or why there is none
 };
 
-// Makes the partial file `partial` (of layout `layout`, with every tile done as `journal`
-// records) the result `output`, with the run's figures; `info` describes it (for its
-// sidecar: the file is not read back). Throws h5::Error or
+// Makes the partial file `partial` (of layout `layout`, with every tile done as the flags
+// `done` say; where each compressed tile lies read from its journal, a window at a time)
+// the result `output`, with the run's figures; `info` describes it (for its sidecar: the
+// data are not read back). Throws h5::Error or
 // std::runtime_error naming the file on failure; the partial file is then as it was
 // (PlacedChunks's undo log), and a resume finishes it.
 FinishReport finish_result(const std::filesystem::path& partial, const std::filesystem::path& output, const ResultInfo& info,
-                           const Tiling& tiling, const PartialLayout& layout, const TileJournal& journal, const RunFigures& run);
+                           const Tiling& tiling, const PartialLayout& layout, std::span<const std::uint8_t> done,
+                           const RunFigures& run);
 
 }  // namespace superball

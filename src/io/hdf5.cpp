@@ -553,4 +553,22 @@ Id simple_space(const std::vector<hsize_t>& dims)
     return space_id(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), "H5Screate_simple");
 }
 
+void read_rows(hid_t dataset, hsize_t first, hsize_t rows, std::span<std::uint64_t> out, const std::string& what)
+{
+    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space " + what);
+    const int rank = H5Sget_simple_extent_ndims(space);
+    if (rank < 1 || rank > 2) throw Error(what + ": a dataset of one or two dimensions expected");
+    std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+    check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), "H5Sget_simple_extent_dims " + what);
+    std::vector<hsize_t> start{first}, count{rows};
+    if (rank == 2) {
+        start.push_back(0);
+        count.push_back(dims[1]);
+    }
+    if (out.size() != rows * (rank == 2 ? dims[1] : 1)) throw std::logic_error("read_rows " + what + ": wrong buffer size");
+    select_box(space, start, count);
+    const Id memory = simple_space(count);
+    check(H5Dread(dataset, H5T_NATIVE_UINT64, memory, space, H5P_DEFAULT, out.data()), "read " + what);
+}
+
 }  // namespace superball::h5

@@ -145,5 +145,8 @@ void select_box(hid_t space, const std::vector<hsize_t>& start, const std::vecto
                 H5S_seloper_t op = H5S_SELECT_SET);
 // A simple dataspace of the given dimensions.
 Id simple_space(const std::vector<hsize_t>& dims);
+// Rows [first, first + rows) of a dataset of one or two dimensions, every column, as
+// unsigned 64-bit integers, into `out` (rows x columns values); `what` names it in errors.
+void read_rows(hid_t dataset, hsize_t first, hsize_t rows, std::span<std::uint64_t> out, const std::string& what);
 
 }  // namespace superball::h5

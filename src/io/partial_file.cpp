@@ -523,37 +523,79 @@ std::vector<TileReport> TileWriter::flush()
 
 // ------------------------------------------------------------------------------ Journal
 
-Journal::Journal(PartialFile& file, TileJournal journal, std::chrono::duration<double> interval)
+Journal::Journal(PartialFile& file, std::vector<std::uint8_t> done, std::chrono::duration<double> interval)
     : file_(file),
-      journal_(std::move(journal)),
+      done_(std::move(done)),
       interval_(interval),
       last_(std::chrono::steady_clock::now()),
-      dirty_begin_(journal_.done.size())
+      dirty_begin_(done_.size())
 {
-    tiles_done_ = static_cast<std::uint64_t>(std::count(journal_.done.begin(), journal_.done.end(), std::uint8_t{1}));
-    if (file_.layout().compressed) journal_.stored.resize(journal_.done.size());
+    tiles_done_ = static_cast<std::uint64_t>(std::count(done_.begin(), done_.end(), std::uint8_t{1}));
 }
 
-void Journal::mark(std::uint64_t tile, std::uint64_t checksum)
+void Journal::write(std::uint64_t offset, const void* data, std::size_t bytes, std::uint64_t first, std::uint64_t last) const
 {
-    if (journal_.done[tile] == 0) ++tiles_done_;
-    journal_.done[tile] = 1;
-    journal_.checksums[tile] = checksum;
+    try {
+        file_.file().write_at(offset, data, bytes);
+    } catch (const std::exception& e) {
+        throw h5::Error(fmt::format("recording tiles {} to {} done in {} failed ({}){}", first, last, file_.path().string(),
+                                    e.what(), free_space_note(file_.path())));
+    }
+}
+
+void Journal::mark(std::uint64_t tile)
+{
+    if (done_[tile] == 0) ++tiles_done_;
+    done_[tile] = 1;
     dirty_begin_ = std::min(dirty_begin_, tile);
     dirty_end_ = std::max(dirty_end_, tile + 1);
 }
 
+namespace {
+
+// Calls write_run(begin, end) for each run [begin, end) of `tiles` whose tile numbers follow
+// one another, of at most 8192 tiles (a run's entries are gathered for one write: 256 KiB).
+template <class Tile, class WriteRun>
+void for_each_run(std::span<const Tile> tiles, WriteRun write_run)
+{
+    constexpr std::size_t longest = 8192;
+    for (std::size_t begin = 0, end = 0; begin < tiles.size(); begin = end) {
+        for (end = begin + 1; end < tiles.size() && end - begin < longest && tiles[end].tile == tiles[end - 1].tile + 1;) ++end;
+        write_run(begin, end);
+    }
+}
+
+}  // namespace
+
 void Journal::record(std::span<const TileReport> tiles)
 {
-    for (const TileReport& r : tiles) mark(r.tile, r.checksum);
+    const PartialLayout& l = file_.layout();
+    for_each_run(tiles, [&](std::size_t begin, std::size_t end) {
+        run_checksums_.clear();
+        for (std::size_t i = begin; i < end; ++i) run_checksums_.push_back(tiles[i].checksum);
+        const std::uint64_t first = tiles[begin].tile, last = tiles[end - 1].tile;
+        write(l.checksums_at + 8 * first, run_checksums_.data(), 8 * run_checksums_.size(), first, last);
+    });
+    for (const TileReport& r : tiles) mark(r.tile);
 }
 
 void Journal::record(std::span<const AppendedTile> tiles)
 {
-    for (const AppendedTile& a : tiles) {
-        journal_.stored[a.tile] = a.stored;
-        mark(a.tile, a.checksum);
-    }
+    static_assert(sizeof(StoredChunk) == 24 && std::is_standard_layout_v<StoredChunk>);
+    const PartialLayout& l = file_.layout();
+    // Where the tiles lie and their checksums, before the flags that vouch for them.
+    for_each_run(tiles, [&](std::size_t begin, std::size_t end) {
+        run_checksums_.clear();
+        run_stored_.clear();
+        for (std::size_t i = begin; i < end; ++i) {
+            run_checksums_.push_back(tiles[i].checksum);
+            run_stored_.push_back(tiles[i].stored);
+        }
+        const std::uint64_t first = tiles[begin].tile, last = tiles[end - 1].tile;
+        write(l.stored_at + 24 * first, run_stored_.data(), 24 * run_stored_.size(), first, last);
+        write(l.checksums_at + 8 * first, run_checksums_.data(), 8 * run_checksums_.size(), first, last);
+    });
+    for (const AppendedTile& a : tiles) mark(a.tile);
 }
 
 bool Journal::due() const { return std::chrono::steady_clock::now() - last_ >= interval_; }
@@ -564,23 +606,42 @@ bool Journal::checkpoint(bool now)
     if (!now && t - last_ < interval_) return false;
     last_ = t;
     if (dirty_end_ <= dirty_begin_) return false;
-    const PartialLayout& l = file_.layout();
-    const std::uint64_t n = dirty_end_ - dirty_begin_;
-    try {
-        // Where the tiles lie and their checksums, before the flags that vouch for them.
-        if (l.compressed) {
-            static_assert(sizeof(StoredChunk) == 24 && std::is_standard_layout_v<StoredChunk>);
-            file_.file().write_at(l.stored_at + 24 * dirty_begin_, journal_.stored.data() + dirty_begin_, 24 * n);
-        }
-        file_.file().write_at(l.checksums_at + 8 * dirty_begin_, journal_.checksums.data() + dirty_begin_, 8 * n);
-        file_.file().write_at(l.done_at + dirty_begin_, journal_.done.data() + dirty_begin_, n);
-    } catch (const std::exception& e) {
-        throw h5::Error(fmt::format("recording tiles {} to {} done in {} failed ({}){}", dirty_begin_, dirty_end_ - 1,
-                                    file_.path().string(), e.what(), free_space_note(file_.path())));
-    }
-    dirty_begin_ = journal_.done.size();
+    write(file_.layout().done_at + dirty_begin_, done_.data() + dirty_begin_, dirty_end_ - dirty_begin_, dirty_begin_,
+          dirty_end_ - 1);
+    dirty_begin_ = done_.size();
     dirty_end_ = 0;
     return true;
+}
+
+std::vector<StoredChunk> read_stored(const PosixFile& file, const PartialLayout& layout, std::uint64_t first,
+                                     std::uint64_t count)
+{
+    std::vector<StoredChunk> stored(count);
+    file.read_at(layout.stored_at + 24 * first, stored.data(), 24 * count);
+    return stored;
+}
+
+JournalRecord read_journal(const PartialFile& file, std::span<const std::uint64_t> tiles)
+{
+    const PartialLayout& l = file.layout();
+    JournalRecord r;
+    r.checksums.reserve(tiles.size());
+    if (l.compressed) r.stored.reserve(tiles.size());
+    constexpr std::uint64_t window = 65536;  // tiles: 2 MiB of the record at most
+    std::vector<std::uint64_t> sums;
+    for (std::size_t begin = 0, end = 0; begin < tiles.size(); begin = end) {
+        const std::uint64_t first = tiles[begin];
+        for (end = begin + 1; end < tiles.size() && tiles[end] - first < window;) ++end;
+        const std::uint64_t count = tiles[end - 1] - first + 1;
+        sums.resize(count);
+        file.file().read_at(l.checksums_at + 8 * first, sums.data(), 8 * count);
+        const std::vector<StoredChunk> stored = l.compressed ? read_stored(file.file(), l, first, count) : std::vector<StoredChunk>{};
+        for (std::size_t i = begin; i < end; ++i) {
+            r.checksums.push_back(sums[tiles[i] - first]);
+            if (l.compressed) r.stored.push_back(stored[tiles[i] - first]);
+        }
+    }
+    return r;
 }
 
 }  // namespace superball

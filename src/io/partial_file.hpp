@@ -257,33 +257,56 @@ private:
     std::vector<TileReport> written_;
 };
 
-// Rank 0's record of finished tiles: kept in memory, written to the partial file's
-// /progress datasets (where the tiles lie and their checksums first, then the done flags
-// that vouch for them) at most every `interval` seconds and when asked.
+// Rank 0's record of finished tiles in the partial file's /progress datasets: where each
+// tile lies and its checksum written as the tile is recorded (one write per run of
+// consecutive tiles), the done flags that vouch for them kept in memory (a byte a tile: the
+// rest of the record is the file's, so that rank 0's memory does not grow by 33 bytes a
+// tile) and written at most every `interval` seconds and when asked.
 class Journal {
 public:
-    // `journal`: the record so far (a resume), one entry per tile.
-    Journal(PartialFile& file, TileJournal journal, std::chrono::duration<double> interval);
+    // `done`: the done flags so far (a resume), one per tile.
+    Journal(PartialFile& file, std::vector<std::uint8_t> done, std::chrono::duration<double> interval);
 
     void record(std::span<const TileReport> tiles);    // uncompressed files
     void record(std::span<const AppendedTile> tiles);  // compressed files
-    // Writes what changed since the last write, if `interval` has passed or `now` is true;
-    // true if it wrote.
+    // Writes the done flags changed since the last write, if `interval` has passed or `now`
+    // is true; true if it wrote.
     bool checkpoint(bool now);
     // `interval` has passed since the last write.
     bool due() const;
     std::uint64_t tiles_done() const { return tiles_done_; }
-    const TileJournal& tiles() const { return journal_; }
+    std::span<const std::uint8_t> done() const { return done_; }
 
 private:
-    void mark(std::uint64_t tile, std::uint64_t checksum);
+    void mark(std::uint64_t tile);
+    // Writes `bytes` at `offset` of the file, for tiles `first` to `last`; h5::Error naming
+    // them (and the file system's free space) if it cannot.
+    void write(std::uint64_t offset, const void* data, std::size_t bytes, std::uint64_t first, std::uint64_t last) const;
 
     PartialFile& file_;
-    TileJournal journal_;
+    std::vector<std::uint8_t> done_;
     std::chrono::duration<double> interval_;
     std::chrono::steady_clock::time_point last_;
-    std::uint64_t dirty_begin_, dirty_end_ = 0;  // tiles changed since the last write
+    std::uint64_t dirty_begin_, dirty_end_ = 0;  // tiles whose flag changed since the last write
     std::uint64_t tiles_done_ = 0;
+    // A run of consecutive tiles' checksums and places, as they are written.
+    std::vector<std::uint64_t> run_checksums_;
+    std::vector<StoredChunk> run_stored_;
 };
+
+// Where the compressed tiles [first, first + count) lie, as the partial file's journal
+// records them (io/layout.hpp: /progress/tile_stored; read from its place in the file).
+std::vector<StoredChunk> read_stored(const PosixFile& file, const PartialLayout& layout, std::uint64_t first,
+                                     std::uint64_t count);
+
+// What the journal records of some tiles: their checksums and, compressed, where they lie.
+struct JournalRecord {
+    std::vector<std::uint64_t> checksums;
+    std::vector<StoredChunk> stored;  // compressed files only (else empty)
+};
+// The record of `tiles` (ascending), read from the partial file a window of tiles at a time,
+// so that reading the record of a few tiles spread over the grid holds little more than
+// theirs.
+JournalRecord read_journal(const PartialFile& file, std::span<const std::uint64_t> tiles);
 
 }  // namespace superball

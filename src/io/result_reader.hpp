@@ -81,11 +81,8 @@ public:
     // Samples of axis k: as many as the dimension, finite, strictly increasing.
     std::vector<double> axis(std::size_t k) const;
 
-    // Partial files: the journal (flags 0 or 1, checked at open) and the checksums.
+    // Partial files: the journal's done flags (0 or 1, checked at open).
     std::vector<std::uint8_t> tiles_done() const;
-    std::vector<std::uint64_t> tile_checksums() const;
-    // Compressed partial files: where each tile's stored chunks lie (else empty).
-    std::vector<StoredChunk> tile_stored() const;
     // Partial files: done tiles whose data no longer match their checksums (reads them all).
     std::vector<std::uint64_t> damaged_tiles() const;
 
@@ -114,6 +111,7 @@ private:
     std::uint64_t read_checked(const Box& box, std::span<std::uint32_t> counts, std::span<std::uint8_t> outcomes) const;
     void validate_values(const Box& box, std::span<const std::uint32_t> counts, std::span<const std::uint8_t> outcomes,
                          std::span<const std::uint8_t> computed) const;
+    void load_journal() const;
     // Whether done tile t still matches its checksum.
     bool tile_intact(std::uint64_t t) const;
     // Checks every done tile that meets `box` and was not checked before.
@@ -128,9 +126,13 @@ private:
     h5::Id counts_;
     h5::Id outcomes_;
     ResultInfo info_;
-    std::vector<std::uint8_t> done_;     // partial files: the journal, read once
-    std::vector<std::uint64_t> sums_;    // partial files: the checksums, read once
-    std::vector<StoredChunk> stored_;    // compressed partial files: where each tile lies
+    std::vector<std::uint8_t> done_;     // partial files: the journal's flags, read at open
+    // Partial files: the checksums and (compressed) where each tile lies, read when a tile is
+    // first read or checked (load_journal), not at open: opening a partial file to resume it
+    // needs only the flags.
+    mutable std::vector<std::uint64_t> sums_;
+    mutable std::vector<StoredChunk> stored_;
+    mutable bool journal_loaded_ = false;
     bool compressed_ = false;            // a partial file of compressed tiles
     mutable std::optional<PosixFile> raw_;
     std::optional<Tiling> tiling_;       // partial files

@@ -27,14 +27,6 @@ struct AppendedTile {
     StoredChunk stored;
 };
 
-// The resume journal: per tile, done or not and the checksum of its stored bytes; for a
-// compressed file, where those bytes lie.
-struct TileJournal {
-    std::vector<std::uint8_t> done;
-    std::vector<std::uint64_t> checksums;
-    std::vector<StoredChunk> stored;  // compressed files only (else empty)
-};
-
 // The checksum of a tile as the partial file stores it: XXH3-64 (xxHash, a stable format)
 // of the tile's chunk of /wall_bounces then its chunk of /outcome, as stored (uncompressed:
 // little-endian, a chunk's points beyond the grid's edge zero; compressed: the stored

@@ -1,5 +1,7 @@
 #include "grid.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <limits>
 
@@ -51,7 +53,14 @@ Tiling default_tiling(const Job& job, int ranks)
     Extent shape;
     for (const Coordinate* c : job.range_axes()) shape.push_back(c->range->n);
     const std::uint64_t points = job.tile_points.value_or(default_tile_points(job.points(), job.refine ? 1 : ranks));
-    return Tiling(shape, default_tile_shape(shape, points));
+    Tiling tiling(shape, default_tile_shape(shape, points));
+    if (tiling.tiles() > max_run_tiles) {
+        throw InputError(fmt::format("this grid's {} points in tiles of {} points make {} tiles: a run takes at most {} "
+                                     "(2^30); [run] tile_points = {} or more makes fewer",
+                                     job.points(), tiling.tile_points(), tiling.tiles(), max_run_tiles,
+                                     (job.points() + max_run_tiles - 1) / max_run_tiles * 2));
+    }
+    return tiling;
 }
 
 CountKernel kernel_for(const Grid& grid, CountKernel chosen)

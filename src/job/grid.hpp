@@ -63,7 +63,7 @@ CountKernel kernel_for(const Grid& grid, CountKernel chosen);
 // The tiling of a new result: [run] tile_points, or a default from the grid size and the
 // rank count. With refinement the results depend on the tile shape (cells do not cross
 // tiles), so there the default ignores the rank count: any number of ranks gives the
-// same file.
+// same file. InputError if it makes more than max_run_tiles tiles (job/tiles.hpp).
 Tiling default_tiling(const Job& job, int ranks);
 
 }  // namespace superball

@@ -105,6 +105,13 @@ Extent default_tile_shape(const Extent& shape, std::uint64_t target_points);
 //   costliest tiles (7.4 s) made its end to end 0.894, 0.903 with 512 (docs/decisions.md).
 std::uint64_t default_tile_points(std::uint64_t grid_points, int ranks);
 
+// A tile's number in the hand-out list every rank holds through a run (run/schedule.hpp):
+// four bytes, not eight (at 4.2 million tiles, 17 MB a rank instead of 34), which holds the
+// number of any tile of a run of at most max_run_tiles (handout_order's keys, up to three
+// times the largest tile, included).
+using ListedTile = std::uint32_t;
+inline constexpr std::uint64_t max_run_tiles = std::uint64_t{1} << 30;
+
 // From this many ranks on, a run hands out its tiles interleaved (handout_order).
 inline constexpr int interleave_ranks_default = 64;
 
@@ -122,6 +129,6 @@ inline constexpr int interleave_ranks_default = 64;
 // each in the first 3 s of a 40 s run; interleaved, 0.2 s: tests/scale). Bit-reversed, any
 // 2^k consecutive granules sample the whole grid evenly, so a block's cost follows its
 // size. Results never depend on the order.
-std::vector<std::uint64_t> handout_order(std::vector<std::uint64_t> pending, std::uint64_t granule, bool interleave);
+std::vector<ListedTile> handout_order(std::vector<ListedTile> pending, std::uint64_t granule, bool interleave);
 
 }  // namespace superball

@@ -231,15 +231,16 @@ std::vector<std::int32_t> Comm::max(const std::vector<std::int32_t>& v) const
     return out;
 }
 
-std::vector<std::uint64_t> Comm::scatter(const std::vector<std::uint64_t>& all, const std::vector<int>& counts) const
+void Comm::send(const std::vector<std::uint64_t>& v, int to, int tag) const
 {
-    std::vector<int> offsets(counts.size());
-    for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-    std::vector<std::uint64_t> mine(static_cast<std::size_t>(counts[static_cast<std::size_t>(rank())]));
-    check(MPI_Scatterv(all.data(), counts.data(), offsets.data(), MPI_UINT64_T, mine.data(), static_cast<int>(mine.size()),
-                       MPI_UINT64_T, 0, comm_),
-          "MPI_Scatterv");
-    return mine;
+    check(MPI_Send(v.data(), static_cast<int>(v.size()), MPI_UINT64_T, to, tag, comm_), "MPI_Send");
+}
+
+std::vector<std::uint64_t> Comm::receive(std::size_t n, int from, int tag) const
+{
+    std::vector<std::uint64_t> v(n);
+    check(MPI_Recv(v.data(), static_cast<int>(n), MPI_UINT64_T, from, tag, comm_, MPI_STATUS_IGNORE), "MPI_Recv");
+    return v;
 }
 
 std::vector<double> Comm::gather(const std::vector<double>& mine) const

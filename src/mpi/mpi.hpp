@@ -107,9 +107,10 @@ public:
     std::vector<std::int32_t> max(const std::vector<std::int32_t>& v) const;
     // Every rank's values concatenated in rank order, on rank 0 (empty elsewhere).
     std::vector<double> gather(const std::vector<double>& mine) const;
-    // Rank 0's `all`, cut in rank order into pieces of counts[r] values (counts the same on
-    // every rank): each rank's piece.
-    std::vector<std::uint64_t> scatter(const std::vector<std::uint64_t>& all, const std::vector<int>& counts) const;
+    // Point to point: `v` to rank `to`, and the `n` values rank `from` sends with the same
+    // `tag` (blocking both).
+    void send(const std::vector<std::uint64_t>& v, int to, int tag) const;
+    std::vector<std::uint64_t> receive(std::size_t n, int from, int tag) const;
 
     // Ends every process of the job: the only way out when one rank fails outside a
     // collective operation.

@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <bit>
 #include <cerrno>
 #include <chrono>
 #include <fstream>
@@ -230,13 +231,12 @@ StartedPartial start_partial(const fs::path& partial, PlanMode mode, const Job& 
             const Tiling tiling = default_tiling(job, ranks);
             p.tile_shape = tiling.tile_shape();
             p.layout = create_partial(partial, job, grid, tiling, provenance);
-            p.journal.done.assign(tiling.tiles(), 0);
-            p.journal.checksums.assign(tiling.tiles(), 0);
+            p.done.assign(tiling.tiles(), 0);
         } else {
             const ResultReader reader(partial);
             p.tile_shape = reader.info().tile_shape;
             p.layout = partial_layout(partial, Tiling(grid.shape(), p.tile_shape));
-            p.journal = {reader.tiles_done(), reader.tile_checksums(), reader.tile_stored()};
+            p.done = reader.tiles_done();
             p.earlier_seconds = reader.info().wall_seconds;
         }
     } catch (const std::exception& e) {
@@ -443,10 +443,10 @@ TileBatch batch_of(std::span<const TileReport> tiles, std::span<const std::byte>
     return batch;
 }
 
-Recorder::Recorder(PartialFile& file, const fs::path& partial, TileJournal journal, const Job& job,
+Recorder::Recorder(PartialFile& file, const fs::path& partial, std::vector<std::uint8_t> done, const Job& job,
                    const PartialLayout& layout, const Tiling& tiling, RunObserver& observer, int writers)
     : partial_(partial), tiling_(tiling), observer_(observer),
-      record_(file, std::move(journal), std::chrono::duration<double>(job.checkpoint_seconds))
+      record_(file, std::move(done), std::chrono::duration<double>(job.checkpoint_seconds))
 {
     if (!layout.compressed) return;
     // Alone, the tiles follow one another from the file's end exactly as they come; with
@@ -579,66 +579,99 @@ StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, 
 
 // The tiles left to compute and how many are done, on every rank, and their points on rank
 // 0, which reports them (from rank 0's journal). A resume first checks that the done tiles
-// still hold what was written: each rank checks a
-// share, and is sent only its share's checksums and places (every rank holding all of them,
-// 40 bytes a done tile, was the most memory a rank of a resume at thousands of ranks took:
-// tests/scale/README.md).
+// still hold what was written: each rank checks a share, and is sent only its share's
+// checksums and places, which rank 0 reads from the journal a share at a time (every rank
+// holding all of them, 40 bytes a done tile, was the most memory a rank of a resume at
+// thousands of ranks took; rank 0 holding all of them at once, 32: tests/scale/README.md).
 struct TilesLeft {
-    std::vector<std::uint64_t> pending;
+    std::vector<ListedTile> pending;
     std::uint64_t done = 0;
     std::uint64_t points_done = 0;  // on rank 0
 };
 
-TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& partial, PlanMode mode,
-                     const TileJournal& journal, const PartialLayout& layout, const Tiling& tiling)
+// A share's record as one message: its checksums, then (compressed) where each tile lies.
+std::vector<std::uint64_t> words_of(const JournalRecord& r)
 {
+    std::vector<std::uint64_t> words = r.checksums;
+    for (const StoredChunk& c : r.stored) words.insert(words.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
+    return words;
+}
+
+JournalRecord record_of(const std::vector<std::uint64_t>& words, std::size_t tiles, bool compressed)
+{
+    JournalRecord r;
+    r.checksums.assign(words.begin(), words.begin() + static_cast<std::ptrdiff_t>(tiles));
+    for (std::size_t i = 0; compressed && i < tiles; ++i) {
+        const std::size_t at = tiles + 3 * i;
+        r.stored.push_back({words[at], words[at + 1], words[at + 2]});
+    }
+    return r;
+}
+
+TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& partial, PlanMode mode,
+                     std::span<const std::uint8_t> done, const Tiling& tiling)
+{
+    if (tiling.tiles() > max_run_tiles) {  // a file no run of this version makes (default_tiling)
+        throw InputError(fmt::format("{} holds {} tiles: a run takes at most {}", partial.string(), tiling.tiles(), max_run_tiles));
+    }
     // The done flags, a bit a tile.
     std::vector<std::uint64_t> bits;
     if (comm.is_root()) {
-        bits.assign((journal.done.size() + 63) / 64, 0);
-        for (std::uint64_t t = 0; t < journal.done.size(); ++t) bits[t / 64] |= std::uint64_t{journal.done[t] != 0} << (t % 64);
+        bits.assign((done.size() + 63) / 64, 0);
+        for (std::uint64_t t = 0; t < done.size(); ++t) bits[t / 64] |= std::uint64_t{done[t] != 0} << (t % 64);
     }
     comm.broadcast(bits);
     const auto is_done = [&](std::uint64_t t) { return ((bits[t / 64] >> (t % 64)) & 1u) != 0; };
     TilesLeft left;
+    // Reserved: grown by doubling, the list would take up to three times its size while it
+    // is built (50 MiB for 16 MiB of it at 2 million tiles).
+    std::uint64_t done_count = 0;
+    for (const std::uint64_t word : bits) done_count += static_cast<std::uint64_t>(std::popcount(word));
+    left.pending.reserve(tiling.tiles() - done_count);
     for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
         if (is_done(t)) {
             ++left.done;
             if (comm.is_root()) left.points_done += tiling.box(t).points();
         } else {
-            left.pending.push_back(t);
+            left.pending.push_back(static_cast<ListedTile>(t));
         }
     }
     if (mode != PlanMode::resume) return left;
     // Rank r checks the done tiles [n r / P, n (r + 1) / P) of the n in order.
     const auto ranks = static_cast<std::uint64_t>(comm.size());
     const auto share_begin = [&](std::uint64_t r) { return left.done * r / ranks; };
-    std::vector<int> counts(ranks), triples(ranks);
-    for (std::uint64_t r = 0; r < ranks; ++r) {
-        counts[r] = static_cast<int>(share_begin(r + 1) - share_begin(r));
-        triples[r] = layout.compressed ? 3 * counts[r] : 0;
-    }
-    std::vector<std::uint64_t> sums, where;  // of every done tile, in order: rank 0 read them
-    if (comm.is_root()) {
-        for (std::uint64_t t = 0; t < journal.done.size(); ++t) {
-            if (journal.done[t] == 0) continue;
-            sums.push_back(journal.checksums[t]);
-            if (layout.compressed) {
-                const StoredChunk& c = journal.stored[t];
-                where.insert(where.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
-            }
-        }
-    }
-    const std::vector<std::uint64_t> my_sums = comm.scatter(sums, counts);
-    const std::vector<std::uint64_t> my_where = comm.scatter(where, triples);
+    constexpr int tag_share = 31;  // before the schedule: no other message is in flight
+    const bool compressed = file.layout().compressed;
     std::vector<std::uint64_t> mine;  // this rank's share of the done tiles
-    const std::uint64_t first = share_begin(static_cast<std::uint64_t>(comm.rank())), last = first + my_sums.size();
-    for (std::uint64_t t = 0, i = 0; t < tiling.tiles() && i < last; ++t) {
-        if (is_done(t) && i++ >= first) mine.push_back(t);
+    JournalRecord record;
+    if (comm.is_root()) {
+        // One pass over the done tiles: each share sent as soon as it is whole.
+        std::vector<std::uint64_t> share;
+        std::uint64_t r = 0;
+        const auto pass_on = [&] {
+            if (r == 0) {
+                record = read_journal(file, share);
+                mine = std::move(share);
+            } else {
+                comm.send(words_of(read_journal(file, share)), static_cast<int>(r), tag_share);
+            }
+            share.clear();
+            ++r;
+        };
+        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
+            if (!is_done(t)) continue;
+            while (share_begin(r) + share.size() == share_begin(r + 1)) pass_on();
+            share.push_back(t);
+        }
+        while (r < ranks) pass_on();
+    } else {
+        const auto rank = static_cast<std::uint64_t>(comm.rank());
+        for (std::uint64_t t = 0, i = 0; t < tiling.tiles() && i < share_begin(rank + 1); ++t) {
+            if (is_done(t) && i++ >= share_begin(rank)) mine.push_back(t);
+        }
+        record = record_of(comm.receive(mine.size() * (compressed ? 4 : 1), 0, tag_share), mine.size(), compressed);
     }
-    std::vector<StoredChunk> stored(my_where.size() / 3);
-    for (std::size_t i = 0; i < stored.size(); ++i) stored[i] = {my_where[3 * i], my_where[3 * i + 1], my_where[3 * i + 2]};
-    if (const std::vector<std::uint64_t> bad = file.damaged(mine, my_sums, stored); !bad.empty()) {
+    if (const std::vector<std::uint64_t> bad = file.damaged(mine, record.checksums, record.stored); !bad.empty()) {
         file.close();
         throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
                                      "checksum written with them; refusing to resume onto it: --overwrite to start "
@@ -698,7 +731,7 @@ FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<R
             } else {
                 observer.finishing();
                 finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout,
-                                       recorder->journal().tiles(), {provenance, seconds_before + seconds, true});
+                                       recorder->journal().done(), {provenance, seconds_before + seconds, true});
             }
         });
         if (failure) {
@@ -791,7 +824,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const PartialLayout& layout = start.layout;
     const Tiling tiling(grid.shape(), start.tile_shape);
     PartialFile file(partial, comm, tiling, layout);
-    TilesLeft left = tiles_left(comm, file, partial, plan.mode, start.journal, layout, tiling);
+    TilesLeft left = tiles_left(comm, file, partial, plan.mode, start.done, tiling);
     ScheduleSettings schedule;
     schedule.node_ranks = settings.node_ranks;
     schedule.writers = static_cast<int>(settings.writers.value_or(job.writers));
@@ -802,7 +835,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
                                  comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(), left.done,
                                  left.points_done};
         observer.started(run_start);
-        recorder.emplace(file, partial, std::move(start.journal), job, layout, tiling, observer, writers);
+        recorder.emplace(file, partial, std::move(start.done), job, layout, tiling, observer, writers);
     }
     // Several writers: rank 0 records where the others wrote and grants them file space;
     // each rank but 0 holds a sink, used if the schedule makes it a writer.
@@ -831,9 +864,9 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
     // and the granule only groups tiles for the interleaved hand-out.
     schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
-    // Every rank holds the hand-out list through the run (8 bytes a tile): made in place
+    // Every rank holds the hand-out list through the run (4 bytes a tile): made in place
     // from what is left, not beside it.
-    const std::vector<std::uint64_t> pending =
+    const std::vector<ListedTile> pending =
         handout_order(std::move(left.pending), schedule.granule, comm.size() >= settings.interleave_ranks);
     left = {};
     const auto compute_start = std::chrono::steady_clock::now();

@@ -88,21 +88,16 @@ bool count_tiles(std::span<const std::uint64_t> pending, std::span<const std::un
 // The tiles done and those left to compute, once the done ones are checked against the
 // checksums written with them.
 std::pair<std::vector<std::uint64_t>, std::vector<std::uint64_t>> tiles_left(PartialFile& file, const fs::path& partial,
-                                                                             const TileJournal& journal,
-                                                                             const PartialLayout& layout, const Tiling& tiling)
+                                                                             std::span<const std::uint8_t> done,
+                                                                             const Tiling& tiling)
 {
-    std::vector<std::uint64_t> done_tiles, sums, pending;
-    std::vector<StoredChunk> stored;
-    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-        if (journal.done[t] == 0) {
-            pending.push_back(t);
-            continue;
-        }
-        done_tiles.push_back(t);
-        sums.push_back(journal.checksums[t]);
-        if (layout.compressed) stored.push_back(journal.stored[t]);
-    }
-    if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, sums, stored); !bad.empty()) {
+    std::vector<std::uint64_t> done_tiles, pending;
+    const auto done_count = static_cast<std::uint64_t>(std::count(done.begin(), done.end(), std::uint8_t{1}));
+    done_tiles.reserve(done_count);
+    pending.reserve(tiling.tiles() - done_count);
+    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) (done[t] == 0 ? pending : done_tiles).push_back(t);
+    const JournalRecord record = read_journal(file, done_tiles);
+    if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, record.checksums, record.stored); !bad.empty()) {
         file.close();
         throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
                                      "written with them; refusing to resume onto it: overwrite to start again, or write "
@@ -146,18 +141,18 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     // The partial file and its journal, as run_explore makes or reads them; the tiling of a
     // new file is the one `mpirun -n THREADS` would choose.
     const Grid grid(job);
-    auto [tile_shape, layout, journal, earlier_seconds] =
+    auto [tile_shape, layout, done, earlier_seconds] =
         start_partial(partial, plan.mode, job, grid, static_cast<int>(threads), provenance);
     const Tiling tiling(grid.shape(), tile_shape);
     PartialFile file(partial, tiling, layout);
-    const auto [done_tiles, pending] = tiles_left(file, partial, journal, layout, tiling);
+    const auto [done_tiles, pending] = tiles_left(file, partial, done, tiling);
     RunStart start{plan.output, plan.note, 1, job.points(), tiling.tiles(), tiling.box(0).points(), done_tiles.size(), 0};
     for (const std::uint64_t t : done_tiles) start.points_done += tiling.box(t).points();
     observer.started(start);
 
     // The writer side, as rank 0's: the journal, and one appender of compressed tiles (or,
     // uncompressed, a writer per thread at the tiles' own offsets).
-    Recorder recorder(file, partial, std::move(journal), job, layout, tiling, observer);
+    Recorder recorder(file, partial, std::move(done), job, layout, tiling, observer);
     std::vector<std::optional<TileWriter>> writers(threads);
     std::vector<std::unique_ptr<ExploreWork>> works;
     for (std::optional<TileWriter>& w : writers) {
@@ -184,7 +179,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
         } else {
             step = "finishing the result from";
             observer.finishing();
-            finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, recorder.journal().tiles(),
+            finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, recorder.journal().done(),
                                    {provenance, earlier_seconds + seconds, true});
         }
     } catch (const std::exception& e) {

@@ -41,8 +41,8 @@ std::unique_ptr<ExploreWork> make_explore_work(const Job& job, const Grid& grid,
 struct StartedPartial {
     Extent tile_shape;
     PartialLayout layout;
-    TileJournal journal;
-    double earlier_seconds = 0;  // of the runs before a resume
+    std::vector<std::uint8_t> done;  // the journal's done flags, a byte a tile
+    double earlier_seconds = 0;      // of the runs before a resume
 };
 StartedPartial start_partial(const std::filesystem::path& partial, PlanMode mode, const Job& job, const Grid& grid, int ranks,
                              const Provenance& provenance);
@@ -55,7 +55,7 @@ StartedPartial start_partial(const std::filesystem::path& partial, PlanMode mode
 // the end, each writer its own, rank 0's share included. Every argument must outlive it.
 class Recorder {
 public:
-    Recorder(PartialFile& file, const std::filesystem::path& partial, TileJournal journal, const Job& job,
+    Recorder(PartialFile& file, const std::filesystem::path& partial, std::vector<std::uint8_t> done, const Job& job,
              const PartialLayout& layout, const Tiling& tiling, RunObserver& observer, int writers = 1);
 
     // The reports of finished tiles, with their compressed data when this process writes them.

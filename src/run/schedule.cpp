@@ -154,7 +154,7 @@ private:
 
 }  // namespace
 
-ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work,
+ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const ListedTile> pending, TileWork& work,
                             const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings,
                             const Writers& writers)
 {

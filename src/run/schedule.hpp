@@ -19,7 +19,7 @@ struct ScheduleResult {
 // Collective over `comm`. `pending` (identical on every rank): the tiles to compute, in
 // the order they are handed out; consecutive entries form the blocks. `writers`: every rank
 // gives a sink or none does.
-ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const std::uint64_t> pending, TileWork& work,
+ScheduleResult run_schedule(const mpi::Comm& comm, std::span<const ListedTile> pending, TileWork& work,
                             const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings = {},
                             const Writers& writers = {});
 

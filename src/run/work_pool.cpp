@@ -132,7 +132,7 @@ std::uint64_t aligned_block(Range r, std::uint64_t n, std::uint64_t granule)
 // tile is asked for its next one too (Down::give_one), one tile per rank out of work.
 class PoolRank {
 public:
-    PoolRank(PoolLinks& links, const PoolPlace& place, std::span<const std::uint64_t> pending, TileWork& work,
+    PoolRank(PoolLinks& links, const PoolPlace& place, std::span<const ListedTile> pending, TileWork& work,
               const TilesDone& done, const StopRequested& stop, const ScheduleSettings& s, const Writers& writers)
         : links_(links), pending_(pending), work_(work), done_(done), stop_(stop), settings_(s), writers_(writers)
     {
@@ -980,7 +980,7 @@ private:
     double last_poll_ = -1;
 
     PoolLinks& links_;
-    std::span<const std::uint64_t> pending_;
+    std::span<const ListedTile> pending_;
     TileWork& work_;
     const TilesDone& done_;
     const StopRequested& stop_;
@@ -1037,7 +1037,7 @@ private:
 
 }  // namespace
 
-PoolResult run_pool(PoolLinks& links, const PoolPlace& place, std::span<const std::uint64_t> pending, TileWork& work,
+PoolResult run_pool(PoolLinks& links, const PoolPlace& place, std::span<const ListedTile> pending, TileWork& work,
                     const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings, const Writers& writers)
 {
     PoolRank s(links, place, pending, work, done, stop, settings, writers);

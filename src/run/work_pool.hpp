@@ -250,7 +250,7 @@ struct PoolResult {
 // One rank's part of the pool, until every rank is done. Every rank passes the same
 // `pending` (the tiles to compute, in the order they are handed out; consecutive entries
 // form the blocks) and settings.
-PoolResult run_pool(PoolLinks& links, const PoolPlace& place, std::span<const std::uint64_t> pending, TileWork& work,
+PoolResult run_pool(PoolLinks& links, const PoolPlace& place, std::span<const ListedTile> pending, TileWork& work,
                     const TilesDone& done, const StopRequested& stop, const ScheduleSettings& settings,
                     const Writers& writers = {});
 

@@ -7,29 +7,31 @@
 #include <random>
 #include <vector>
 
+#include "job/grid.hpp"
+#include "job/job.hpp"
 #include "job/tiles.hpp"
 
 namespace superball {
 namespace {
 
-std::vector<std::uint64_t> iota(std::uint64_t n)
+std::vector<ListedTile> iota(std::uint64_t n)
 {
-    std::vector<std::uint64_t> v(n);
-    std::iota(v.begin(), v.end(), std::uint64_t{0});
+    std::vector<ListedTile> v(n);
+    std::iota(v.begin(), v.end(), ListedTile{0});
     return v;
 }
 
 TEST(HandoutOrder, NotInterleavedKeepsTheGridOrder)
 {
-    const std::vector<std::uint64_t> pending = iota(1000);
+    const std::vector<ListedTile> pending = iota(1000);
     EXPECT_EQ(handout_order(pending, 8, false), pending);
 }
 
 TEST(HandoutOrder, ManyRanksTakeWholeGranulesInBitReversedOrder)
 {
     // 8 granules of 4 tiles: granules 0 4 2 6 1 5 3 7, each in its own order.
-    const std::vector<std::uint64_t> order = handout_order(iota(32), 4, true);
-    const std::vector<std::uint64_t> granules{0, 4, 2, 6, 1, 5, 3, 7};
+    const std::vector<ListedTile> order = handout_order(iota(32), 4, true);
+    const std::vector<ListedTile> granules{0, 4, 2, 6, 1, 5, 3, 7};
     ASSERT_EQ(order.size(), 32u);
     for (std::size_t i = 0; i < order.size(); ++i) {
         EXPECT_EQ(order[i], granules[i / 4] * 4 + i % 4) << "position " << i;
@@ -40,7 +42,7 @@ TEST(HandoutOrder, AnyPrefixOfAPowerOfTwoGranulesSpreadsOverTheGrid)
 {
     // 1024 granules: the first 2^k granules handed out fall one in each 1/2^k of the grid.
     const std::uint64_t granule = 16, granules = 1024;
-    const std::vector<std::uint64_t> order = handout_order(iota(granule * granules), granule, true);
+    const std::vector<ListedTile> order = handout_order(iota(granule * granules), granule, true);
     for (std::uint64_t k = 1; k <= granules; k *= 2) {
         std::vector<int> hits(k, 0);
         for (std::uint64_t g = 0; g < k; ++g) ++hits[order[g * granule] / granule / (granules / k)];
@@ -52,12 +54,12 @@ TEST(HandoutOrder, EveryTileOnceAndIncompleteGranulesLast)
 {
     // A resume: tiles done here and there leave some granules incomplete; the grid's last
     // granule is short too (103 tiles, granule 8).
-    std::vector<std::uint64_t> pending;
+    std::vector<ListedTile> pending;
     for (std::uint64_t t = 0; t < 103; ++t) {
         if (t != 17 && t != 18 && t != 60) pending.push_back(t);
     }
-    const std::vector<std::uint64_t> order = handout_order(pending, 8, true);
-    std::vector<std::uint64_t> sorted = order;
+    const std::vector<ListedTile> order = handout_order(pending, 8, true);
+    std::vector<ListedTile> sorted = order;
     std::sort(sorted.begin(), sorted.end());
     EXPECT_EQ(sorted, pending);
     // Whole granules first, each a run of 8 consecutive tiles starting on a multiple of 8
@@ -68,16 +70,16 @@ TEST(HandoutOrder, EveryTileOnceAndIncompleteGranulesLast)
         EXPECT_EQ(order[i] % 8, 0u) << "position " << i;
         for (std::size_t j = 1; j < 8; ++j) EXPECT_EQ(order[i + j], order[i] + j);
     }
-    const std::vector<std::uint64_t> tail(order.begin() + static_cast<std::ptrdiff_t>(whole), order.end());
-    const std::vector<std::uint64_t> expected{16, 19, 20, 21, 22, 23, 56, 57, 58, 59, 61, 62, 63, 96, 97, 98, 99, 100, 101, 102};
+    const std::vector<ListedTile> tail(order.begin() + static_cast<std::ptrdiff_t>(whole), order.end());
+    const std::vector<ListedTile> expected{16, 19, 20, 21, 22, 23, 56, 57, 58, 59, 61, 62, 63, 96, 97, 98, 99, 100, 101, 102};
     EXPECT_EQ(tail, expected);
 }
 
 // The order as job/tiles.hpp states it, built the plain way: runs of a granule's pending
 // tiles, whole ones by bit-reversed granule number, then the incomplete ones in grid order.
-std::vector<std::uint64_t> order_as_stated(const std::vector<std::uint64_t>& pending, std::uint64_t granule)
+std::vector<ListedTile> order_as_stated(const std::vector<ListedTile>& pending, std::uint64_t granule)
 {
-    std::vector<std::vector<std::uint64_t>> runs;
+    std::vector<std::vector<ListedTile>> runs;
     for (const std::uint64_t t : pending) {
         if (runs.empty() || runs.back().back() / granule != t / granule) runs.emplace_back();
         runs.back().push_back(t);
@@ -90,12 +92,12 @@ std::vector<std::uint64_t> order_as_stated(const std::vector<std::uint64_t>& pen
         for (int b = 0; b < bits; ++b) r = (r << 1) | ((g >> b) & 1u);
         return r;
     };
-    const auto whole = [granule](const std::vector<std::uint64_t>& r) { return r.size() == granule; };
+    const auto whole = [granule](const std::vector<ListedTile>& r) { return r.size() == granule; };
     std::stable_sort(runs.begin(), runs.end(), [&](const auto& a, const auto& b) {
         if (whole(a) != whole(b)) return whole(a);
         return whole(a) && reversed(a.front() / granule) < reversed(b.front() / granule);
     });
-    std::vector<std::uint64_t> order;
+    std::vector<ListedTile> order;
     for (const auto& r : runs) order.insert(order.end(), r.begin(), r.end());
     return order;
 }
@@ -107,7 +109,7 @@ TEST(HandoutOrder, AsStatedForRandomResumesAndGranules)
     std::mt19937_64 random(32);
     for (const std::uint64_t granule : {1u, 2u, 3u, 8u, 16u}) {
         for (const std::uint64_t tiles : {1u, 7u, 64u, 1000u, 4099u}) {
-            std::vector<std::uint64_t> pending;
+            std::vector<ListedTile> pending;
             for (std::uint64_t t = 0; t < tiles; ++t) {
                 if (random() % 5 != 0) pending.push_back(t);
             }
@@ -144,6 +146,28 @@ TEST(DefaultTilePoints, LargeChunksOnFewRanksManyTilesOnMany)
 TEST(HandoutOrder, NothingPending)
 {
     EXPECT_TRUE(handout_order({}, 8, true).empty());
+}
+
+// The hand-out list holds four-byte tile numbers: a job that would make more tiles than a
+// run takes is refused before anything is made, naming the setting to raise.
+TEST(DefaultTiling, MoreTilesThanARunTakesIsRefused)
+{
+    const auto job = [](const std::string& tile_points) {
+        return parse_job("[model]\ne = 0.9\nalpha = 0.9\n[grid]\ncoordinates = \"canonical\"\n"
+                         "xi = { min = 0, max = 1, n = 65536 }\nU = { min = -3, max = 0, n = 32768 }\nW = 0\n"
+                         "[run]\nmax_bounces = 10\ntile_points = " + tile_points + "\n",
+                         "test.toml");
+    };
+    // 2^31 points: tiles of 2 points make 2^30, the most a run takes; of 1, twice that.
+    EXPECT_EQ(default_tiling(job("2"), 1).tiles(), max_run_tiles);
+    try {
+        default_tiling(job("1"), 1);
+        FAIL() << "2^31 tiles accepted";
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("2147483648 tiles"), std::string::npos) << m;
+        EXPECT_NE(m.find("[run] tile_points = 4 or more"), std::string::npos) << m;
+    }
 }
 
 }  // namespace

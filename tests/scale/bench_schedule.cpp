@@ -60,7 +60,7 @@ int main(int argc, char** argv)
     const std::uint64_t tiles = argc > 1 ? std::stoull(argv[1]) : 65536;
     const int reps = argc > 2 ? std::stoi(argv[2]) : 5;
     const double work = (argc > 3 ? std::stod(argv[3]) : 17) * 1e-6;
-    std::vector<std::uint64_t> pending(tiles);
+    std::vector<ListedTile> pending(tiles);
     for (std::uint64_t t = 0; t < tiles; ++t) pending[t] = t;
     std::vector<double> times;
     std::uint64_t requests = 0;

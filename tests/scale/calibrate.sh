@@ -16,7 +16,10 @@
 #                     "finished ... after the last tile was counted"): the trivial grid
 #                     compressed in 65536 tiles of 1024 points and in 256 of 262144;
 #   COPY_GBPS         GB/s of payload a writer copies (two copies a byte: bench_copy);
-#   HASH_GBPS         GB/s of stored tiles a rank checks on a resume (bench_hash).
+#   HASH_GBPS         GB/s of stored tiles a rank checks on a resume (bench_hash);
+#   JOURNAL_US_PER_RUN rank 0's time to write the places and checksums of a run of
+#                     consecutive tiles into the journal as it records them (bench_journal:
+#                     every tile a run of its own).
 #
 # How far and how fast a job's data compress is the job's own (tests/scale/chunk_ratio.py
 # with codec_speed, run by simulate.sh); as a cross-check, the comment states the
@@ -34,7 +37,7 @@ cd "$root"
 reps=${1:-5}
 .ci/install-deps >/dev/null
 cmake --preset release >/dev/null
-cmake --build build/release -j2 --target superball bench_copy bench_hash >/dev/null
+cmake --build build/release -j2 --target superball bench_copy bench_hash bench_journal >/dev/null
 if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 superball=$root/build/release/src/superball
 work=$root/build/scale/calibrate
@@ -80,14 +83,15 @@ for ((r = 0; r < reps; r++)); do
 done
 copy=$("$root/build/release/tests/scale/bench_copy" | tail -1)
 hash=$("$root/build/release/tests/scale/bench_hash" | tail -1)
+journal=$("$root/build/release/tests/scale/bench_journal" | tail -1)
 load=$(cut -d' ' -f1-3 /proc/loadavg)
 garwin_tiles=$("$superball" explore "$work/garwin.toml" --dry-run | sed -n 's/^tiles: \([0-9]*\) .*/\1/p')
 /usr/bin/python3 - "$work" "$garwin_tiles" "${times[trivial_big]}" "${times[trivial_small]}" "${times[garwin]}" \
-  "${times[slice_c0]}" "${times[slice_c4]}" "${finish[trivial_big_c4]}" "${finish[trivial_small_c4]}" "$copy" "$load" "$hash" <<'EOF' >tests/scale/calibration.env
+  "${times[slice_c0]}" "${times[slice_c4]}" "${finish[trivial_big_c4]}" "${finish[trivial_small_c4]}" "$copy" "$load" "$hash" "$journal" <<'EOF' >tests/scale/calibration.env
 import statistics, sys, h5py, numpy as np, datetime
 work, garwin_tiles = sys.argv[1], int(sys.argv[2])
 big, small, garwin, c0, c4, fin_big, fin_small = [[float(x) for x in a.split()] for a in sys.argv[3:10]]
-copy_gbps, load, hash_gbps = float(sys.argv[10]), sys.argv[11], float(sys.argv[12])
+copy_gbps, load, hash_gbps, journal_us = float(sys.argv[10]), sys.argv[11], float(sys.argv[12]), float(sys.argv[13])
 med = statistics.median
 points = 8192 * 8192
 tiles_big, tiles_small = points // 262144, points // 1024
@@ -107,7 +111,7 @@ print(f"# with 262144-point tiles, {med(small):.3f} s with 1024-point tiles; Gar
 print(f"# {n.sum():.4g} bounces; all three uncompressed. Benchmark slice 8192^2 (201 MB raw) {med(c0):.3f} s")
 print(f"# uncompressed, {med(c4):.3f} s at level 4. Trivial grid at level 4: finished {med(fin_big) * 1e3:.1f} ms after")
 print(f"# the last tile in 256 tiles, {med(fin_small) * 1e3:.1f} ms in 65536. bench_copy: {copy_gbps} GB/s;")
-print(f"# bench_hash: {hash_gbps} GB/s.")
+print(f"# bench_hash: {hash_gbps} GB/s; bench_journal: {journal_us} us a run of tiles.")
 print(f"# The slice's compression, as the difference of two compute phases: {compress_mbps:.0f} MB/s of raw data;")
 print(f"# simulate.sh measures each job's own with codec_speed.)")
 print(f"NS_PER_POINT={ns_per_point:.2f}")
@@ -116,5 +120,6 @@ print(f"US_PER_TILE={us_per_tile:.2f}")
 print(f"INDEX_US_PER_TILE={index_us:.2f}")
 print(f"COPY_GBPS={copy_gbps:.1f}")
 print(f"HASH_GBPS={hash_gbps:.1f}")
+print(f"JOURNAL_US_PER_RUN={journal_us:.2f}")
 EOF
 cat tests/scale/calibration.env

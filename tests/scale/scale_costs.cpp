@@ -158,9 +158,9 @@ int main(int argc, char** argv)
                 done[t] = true;
             }
         }
-        std::vector<std::uint64_t> pending;
+        std::vector<ListedTile> pending;
         for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-            if (!done[t]) pending.push_back(t);
+            if (!done[t]) pending.push_back(static_cast<ListedTile>(t));
         }
         for (const std::uint64_t t : handout_order(pending, granule, ranks >= interleave_ranks_default)) put(out, t);
         if (!out) throw std::runtime_error(std::string("cannot write ") + argv[7]);

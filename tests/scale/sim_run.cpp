@@ -25,7 +25,8 @@
 //   smpirun -np P -platform P.xml -hostfile H sim_run COSTS.bin [--node-ranks 32]
 //       [--report-seconds 1] [--granule 1] [--block-divisor 2] [--dedicated-root-ranks 64] [--idle-poll 1e-3]
 //       [--uncompressed] [--flush-bytes 6291456] [--journal-seconds 10] [--compress-mbps 650] [--compress-ratio 100]
-//       [--index-us-per-tile 4] [--copy-gbps 10] [--hash-gbps 10] [--startup-seconds S] [--no-io] [--serve-every 0.05]
+//       [--index-us-per-tile 4] [--copy-gbps 10] [--hash-gbps 10] [--journal-us-per-run 1.95] [--startup-seconds S]
+//       [--no-io] [--serve-every 0.05]
 //       [--server-serve-every 0.005] [--writers N (0: auto)] [--alignment 1048576] [--resumed]
 //       [--trace] [--trace-bucket 1] [--noise SIGMA] [--slow-nodes FRACTION:SPEED] [--seed 1]
 //       [--lose-node-at S --lost-record FILE]
@@ -94,6 +95,8 @@ public:
         cost_ = reinterpret_cast<const double*>(bytes + 32);
         tile_points_ = reinterpret_cast<const std::uint64_t*>(bytes + 32 + 8 * tiles_);
         pending_ = reinterpret_cast<const std::uint64_t*>(bytes + 32 + 16 * tiles_);
+        if (tiles_ > max_run_tiles) throw std::runtime_error(path + ": more tiles than a run takes");
+        listed_.assign(pending_, pending_ + pending_count_);
     }
     ~Costs() { ::munmap(data_, size_); }
     Costs(const Costs&) = delete;
@@ -105,6 +108,8 @@ public:
     double cost(std::uint64_t t) const { return cost_[t]; }
     std::uint64_t tile_points(std::uint64_t t) const { return tile_points_[t]; }
     std::span<const std::uint64_t> pending() const { return {pending_, pending_count_}; }
+    // The hand-out list as the program holds it (job/tiles.hpp ListedTile), shared likewise.
+    std::span<const ListedTile> listed() const { return listed_; }
 
 private:
     void* data_ = nullptr;
@@ -113,6 +118,7 @@ private:
     const double* cost_ = nullptr;
     const std::uint64_t* tile_points_ = nullptr;
     const std::uint64_t* pending_ = nullptr;
+    std::vector<ListedTile> listed_;
 };
 
 struct Options {
@@ -146,6 +152,11 @@ struct Options {
     // How fast a rank computes a done tile's checksum on a resume (XXH3 of its stored
     // bytes): calibrate.sh measures it (HASH_GBPS), simulate.sh passes it.
     double hash_gbps = 10;
+    // Rank 0's time to write the places and checksums of a run of consecutive tiles into the
+    // journal as it records them (Journal::record, a write each per run): calibrate.sh
+    // measures it (JOURNAL_US_PER_RUN, bench_journal: every tile a run of its own),
+    // simulate.sh passes it.
+    double journal_us_per_run = 1.95;
     // File space is granted to writers in units of this (the job's [run] alignment).
     double alignment = 1 << 20;
     // This run resumes an interrupted one (the costs file holds the tiles left).
@@ -196,6 +207,7 @@ Options parse(int argc, char** argv)
         else if (a == "--copy-gbps") o.copy_gbps = std::stod(value());
         else if (a == "--startup-seconds") o.startup_seconds = std::stod(value());
         else if (a == "--hash-gbps") o.hash_gbps = std::stod(value());
+        else if (a == "--journal-us-per-run") o.journal_us_per_run = std::stod(value());
         else if (a == "--writers") o.schedule.writers = std::stoi(value());
         else if (a == "--alignment") o.alignment = std::stod(value());
         else if (a == "--resumed") o.resumed = true;
@@ -759,11 +771,12 @@ private:
 };
 
 // The modelled memory of a rank beyond its counting's own buffers (explore's, bytes): the
-// hand-out list every rank holds (8 bytes a pending tile); a resume's done flags (a bit a
-// tile) and the rank's share of the done tiles' checksums and places (40 bytes each: tile,
-// checksum, place), rank 0 all of them (32 bytes a done tile) before it sends them; on
-// rank 0 the journal (TileJournal: a flag, a checksum and a place, 33 bytes a tile), its
-// appender's two buffers and the largest message it takes; a rank's compressed tiles
+// hand-out list every rank holds (4 bytes a pending tile: ListedTile); a resume's done
+// flags (a bit a tile) and the rank's share of the done tiles' checksums and places (40
+// bytes each: tile, checksum, place), on rank 0 also the share it is sending (32 bytes a
+// done tile of it) and the window of the journal it reads them from (2 MiB); on rank 0 the
+// journal's done flags (a byte a tile: the checksums and places are written to the file as
+// tiles are recorded, Journal), its appender's two buffers and the largest message it takes; a rank's compressed tiles
 // before it sends them and their packed copy; a writer's waiting tiles, buffers and the
 // largest message; a leader passing its node's tiles on, its outbox of up to 8 MiB and the
 // message it makes of it.
@@ -802,16 +815,21 @@ int run(int argc, char** argv)
     // creates the partial file (create, the HDF5 objects and the journal's datasets, a flush:
     // compressed, 14 KB and 35 bytes a tile in 16 write calls, measured as
     // Options::create_writes was; 9 bytes a tile uncompressed). A resume (--resumed): rank 0
-    // looks for an undo log, opens the partial file with HDF5 and reads its journal (33 bytes
-    // a tile); the done flags, a bit a tile, are broadcast to every rank (charged as a
-    // scatter and an allgather, van de Geijn's large broadcast: 2 B / link bandwidth, plus a
-    // latency per level of the tree), and each rank is sent its share of the done tiles'
-    // checksums and places (32 bytes a done tile, all of them leaving rank 0's link); each
+    // looks for an undo log, opens the partial file with HDF5 and reads its journal
+    // (ResultReader: the done flags, and compressed the places, checked, and read again with
+    // the flags for the data's ranges, 51 bytes a tile; then the record of each rank's share
+    // of the done tiles, read a window of tiles at a time, 32 bytes a tile: 83 bytes a tile
+    // compressed, 9 uncompressed); the done flags, a bit a tile, are broadcast to every rank
+    // (charged as a scatter and an allgather, van de Geijn's large broadcast: 2 B / link
+    // bandwidth, plus a latency per level of the tree), and each rank is sent its share of
+    // the done tiles' checksums and places (32 bytes a done tile, 8 uncompressed, all of
+    // them leaving rank 0's link, one message a rank after the other); each
     // rank opens the file, reads its share of the done tiles one pread each through its
     // client and hashes them (--hash-gbps), and the ranks gather what they found. Then the ranks
     // that write open the file (POSIX: a rank opens it when it first uses it; uncompressed,
     // every rank writes).
     const double journal_bytes_per_tile = o.compressed ? 35.0 : 9.0;
+    const double journal_read_per_tile = o.compressed ? 83.0 : 9.0;
     const double t0 = MPI_Wtime();
     double restart_s = 0;
     if (!o.resumed) {
@@ -827,7 +845,7 @@ int run(int argc, char** argv)
         if (rank == 0) {
             fs.metadata();  // the undo log looked for
             fs.metadata();  // the HDF5 open
-            fs.client_read(journal_bytes_per_tile * tiles + 14336);
+            fs.client_read(journal_read_per_tile * tiles + 14336);
             fs.metadata();  // the close
             std::vector<bool> pend(costs.tiles(), false);
             for (const std::uint64_t t : costs.pending()) pend[t] = true;
@@ -839,7 +857,7 @@ int run(int argc, char** argv)
         world.barrier();
         const double levels = std::ceil(std::log2(std::max(2, ranks)));
         const double bcast = levels * 2e-6 + 2 * (tiles / 8) / 12.5e9;
-        const double scatter = levels * 2e-6 + 32 * done_tiles / 12.5e9;
+        const double scatter = ranks * 2e-6 + (o.compressed ? 32 : 8) * done_tiles / 12.5e9;
         simgrid::s4u::this_actor::sleep_for(bcast + scatter);
         const auto n = static_cast<std::uint64_t>(done.size());
         const std::uint64_t begin = n * static_cast<std::uint64_t>(rank) / static_cast<std::uint64_t>(ranks);
@@ -870,17 +888,22 @@ int run(int argc, char** argv)
     if (opens && !(o.resumed && rank != 0)) fs.metadata();
     world.barrier();
 
-    // Rank 0: the appender of compressed tiles, and a checkpoint every journal_seconds
-    // (explore.cpp `checkpoint`): the appender flushed (its last write waited for), the
-    // journal written (Journal::checkpoint: the range from the first to the last tile
-    // recorded since the last one, in one write per dataset: where the tiles lie, 24 bytes
-    // a tile, their checksums, 8, their flags, 1; with interleaved hand-out that range is
-    // most of the grid), then the file covered (PlacedChunks::cover, rank 0 alone: the undo
+    // Rank 0: the appender of compressed tiles; the tiles it records write their places and
+    // checksums into the journal (Journal::record: each run of consecutive tiles of a batch
+    // --journal-us-per-run of rank 0's CPU and two write calls, one uncompressed; 32 bytes a
+    // tile, 8 uncompressed, gathered by the client's cache and charged at the next
+    // checkpoint); a checkpoint every journal_seconds (explore.cpp
+    // `checkpoint`): the appender flushed (its last write waited for), the journal's done
+    // flags written (Journal::checkpoint: the range from the first to the last tile
+    // recorded since the last one, a byte a tile, in one write; with interleaved hand-out
+    // that range is most of the grid), then the file covered (PlacedChunks::cover, rank 0 alone: the undo
     // log created and its header written, the HDF5 open, its superblock read, logged and
     // rewritten, the close, the log unlinked: four small operations and four on metadata).
     std::optional<Appender> appender;
     if (rank == 0 && o.compressed && o.io) appender.emplace(fs, o.append_bytes);
     std::uint64_t dirty_begin = costs.tiles(), dirty_end = 0;
+    std::uint64_t journal_unflushed = 0;  // tiles recorded since the last checkpoint
+    std::uint64_t journal_runs = 0;       // of which runs of consecutive tiles
     double next_journal = MPI_Wtime() + o.journal_seconds;
     double checkpoint_s = 0;
     const auto checkpoint = [&](bool cover) {
@@ -888,8 +911,8 @@ int run(int argc, char** argv)
         if (appender) appender->flush();
         if (dirty_end > dirty_begin) {
             const auto n = static_cast<double>(dirty_end - dirty_begin);
-            if (o.compressed) fs.client_write(24 * n, 0);
-            fs.client_write(8 * n, 0);
+            const auto m = static_cast<double>(journal_unflushed);
+            fs.client_write((o.compressed ? 32 : 8) * m, 0, (o.compressed ? 2 : 1) * static_cast<double>(journal_runs));
             fs.client_write(n, 0);
             if (cover && appender) {
                 fs.metadata();
@@ -901,6 +924,7 @@ int run(int argc, char** argv)
         }
         dirty_begin = costs.tiles();
         dirty_end = 0;
+        journal_unflushed = journal_runs = 0;
         recorded = reported_tiles.size();
         checkpoint_s += MPI_Wtime() - begin;
     };
@@ -910,6 +934,7 @@ int run(int argc, char** argv)
     const auto wall_start = std::chrono::steady_clock::now();
     double copy_s = 0;
     const auto record = [&](std::uint64_t tile) {
+        ++journal_unflushed;
         dirty_begin = std::min(dirty_begin, tile);
         dirty_end = std::max(dirty_end, tile + 1);
         reported_tiles.push_back(tile);
@@ -920,6 +945,19 @@ int run(int argc, char** argv)
             next_mark += costs.pending().size() / 10;
         }
     };
+    // Journal::record's writes, on rank 0's main thread.
+    double journal_s = 0;
+    const auto journal_cpu = [&](auto tiles_recorded) {
+        std::uint64_t runs = 0;
+        for (std::size_t i = 0; i < tiles_recorded.size(); ++i) {
+            if (i == 0 || tiles_recorded[i].tile != tiles_recorded[i - 1].tile + 1) ++runs;
+        }
+        journal_runs += runs;
+        const double cpu = static_cast<double>(runs) * o.journal_us_per_run * 1e-6;
+        if (cpu <= 0 || !o.io) return;
+        smpi_execute(cpu);
+        journal_s += cpu;
+    };
     const auto maybe_checkpoint = [&] {
         if (MPI_Wtime() >= next_journal) {
             next_journal = MPI_Wtime() + o.journal_seconds;
@@ -928,6 +966,7 @@ int run(int argc, char** argv)
     };
     const TilesDone done = [&](std::span<const TileReport> tiles_done, int, std::span<const std::byte> payload) {
         for (const TileReport& t : tiles_done) record(t.tile);
+        journal_cpu(tiles_done);
         if (appender) {
             // TileBatch::unpack's copy and ChunkAppender::add's, on rank 0's main thread.
             const double copy = 2.0 * static_cast<double>(payload.size()) / (o.copy_gbps * 1e9);
@@ -940,6 +979,7 @@ int run(int argc, char** argv)
     if (rank == 0 && writer_count > 1) {
         writing.placed = [&](std::span<const AppendedTile> placed) {
             for (const AppendedTile& t : placed) record(t.tile);
+            journal_cpu(placed);
             maybe_checkpoint();
         };
         writing.grant = [&](std::uint64_t bytes) {
@@ -983,7 +1023,7 @@ int run(int argc, char** argv)
             std::_Exit(0);
         })->daemonize();
     }
-    const ScheduleResult r = run_schedule(world, costs.pending(), work, done, [] { return false; }, o.schedule, writing);
+    const ScheduleResult r = run_schedule(world, costs.listed(), work, done, [] { return false; }, o.schedule, writing);
     const double scheduled = world.max(MPI_Wtime());
     if (o.trace) {
         // Every rank's time between tiles, summed by second of the run: where the waits are.
@@ -1050,9 +1090,9 @@ int run(int argc, char** argv)
 
     // The memory model (Memory above), this rank's.
     Memory mem;
-    mem.list = 8 * pending;
-    mem.resume = o.resumed ? tiles / 8 + 40 * done_tiles / ranks + (rank == 0 ? 32 * done_tiles : 0.0) : 0.0;
-    mem.journal = rank == 0 ? 33 * tiles : 0.0;
+    mem.list = 4 * pending;
+    mem.resume = o.resumed ? tiles / 8 + 40 * done_tiles / ranks + (rank == 0 ? 32 * done_tiles / ranks + (2 << 20) : 0.0) : 0.0;
+    mem.journal = rank == 0 ? tiles : 0.0;
     const double message = 8 << 20;  // the largest message a server takes: a leader's 8 MiB of its node's
     mem.buffers = 2 * work.max_batch_bytes;
     if (rank == 0 && o.compressed) mem.buffers += 2 * o.append_bytes + message;
@@ -1098,7 +1138,7 @@ int run(int argc, char** argv)
                     "root_requests=%llu root_messages=%llu max_leader_messages=%.0f root_blocks=%zu io_ops=%.0f two_level=%d "
                     "given_back=%.0f root_asked_back=%llu idle_s_per_rank=%.6g reported=%llu compressed=%d payload_bytes=%.6g "
                     "written_by_root=%.6g root_writes=%.0f writer_busy_s=%.6g writer_backlog_bytes=%.6g root_held_back_s=%.6g "
-                    "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g checkpoint_s=%.6g computing_ranks=%.0f tiles_min=%.0f "
+                    "root_peak_ingress_bytes_per_s=%.6g root_copy_s=%.6g root_journal_s=%.6g checkpoint_s=%.6g computing_ranks=%.0f tiles_min=%.0f "
                     "tiles_max=%.0f write_calls=%.0f bytes_written=%.0f writers=%d written_by_writers=%.6g "
                     "writer_bytes_max=%.6g writer_held_back_max_s=%.6g writer_peak_ingress_bytes_per_s=%.6g writers_copy_s=%.6g "
                     "root_grants=%llu metadata_wait_max_s=%.6g writer_space_wait_max_s=%.6g rank_mib=%.1f root_mib=%.1f "
@@ -1109,7 +1149,7 @@ int run(int argc, char** argv)
                     static_cast<unsigned long long>(r.stats.messages_in), leader_messages, r.stats.handed_out.size(), ops,
                     r.stats.two_level ? 1 : 0, given_back, static_cast<unsigned long long>(r.stats.asked_back), idle / ranks,
                     static_cast<unsigned long long>(reported), o.compressed ? 1 : 0, payload, written, writes, writer_busy,
-                    backlog, held_back, peak_ingress, copy_s, checkpoint_s, computing, tiles_min, tiles_max, write_calls,
+                    backlog, held_back, peak_ingress, copy_s, journal_s, checkpoint_s, computing, tiles_min, tiles_max, write_calls,
                     bytes_written, writer_count, by_writers, writer_bytes_max, writer_held_back, writer_peak_ingress, writers_copy,
                     static_cast<unsigned long long>(root_grants), metadata_wait, space_wait, rank_mib, mem.total() / (1 << 20),
                     other_mib);

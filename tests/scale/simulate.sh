@@ -274,7 +274,7 @@ EOF
       compress_mbps=$(sed -n 's/.* compress_mbps=\([^ ]*\).*/\1/p' "$ratio_file")
       alignment=$(/usr/bin/python3 -c 'import sys, tomllib; print(tomllib.load(open(sys.argv[1], "rb")).get("run", {}).get("alignment", 1048576))' "$job")
       write=(--compress-mbps "$compress_mbps" --compress-ratio "$ratio" --index-us-per-tile "$INDEX_US_PER_TILE"
-             --copy-gbps "$COPY_GBPS" --hash-gbps "$HASH_GBPS" --writers "$writers_arg" --alignment "$alignment")
+             --copy-gbps "$COPY_GBPS" --hash-gbps "$HASH_GBPS" --journal-us-per-run "$JOURNAL_US_PER_RUN" --writers "$writers_arg" --alignment "$alignment")
     fi
     # Serve is called every 512 points in the real counter; the model calls it at least
     # every 1/2000 of the ideal run time (0.05 s at 4096 ranks), which keeps the number of

@@ -138,7 +138,7 @@ struct Outcome {
     std::vector<std::vector<std::uint64_t>> stats;  // per rank: tiles, blocks, flushes, computed (0/1), two_level, given_back
 };
 
-Outcome run_once(const std::vector<std::uint64_t>& pending, const ScheduleSettings& settings, double tile_seconds,
+Outcome run_once(const std::vector<ListedTile>& pending, const ScheduleSettings& settings, double tile_seconds,
         const std::function<bool(const FakeWork&)>& stop_when = nullptr)
 {
     FakeWork work(tile_seconds);
@@ -168,7 +168,7 @@ Outcome run_once(const std::vector<std::uint64_t>& pending, const ScheduleSettin
 // On rank 0: each reported tile was computed and written by the rank named, before it was
 // reported, with its checksum and payload; no tile twice; every computed tile reported (all of them
 // are written by the end, stopped or not); every pending tile when not interrupted.
-void expect_reported_once(const Outcome& r, const std::vector<std::uint64_t>& pending)
+void expect_reported_once(const Outcome& r, const std::vector<ListedTile>& pending)
 {
     if (!world.is_root()) return;
     std::map<std::uint64_t, std::pair<int, double>> written;  // tile -> rank, time written
@@ -225,25 +225,25 @@ INSTANTIATE_TEST_SUITE_P(Modes, Schedule,
                          [](const testing::TestParamInfo<Mode>& i) { return std::string(i.param.name); });
 
 // Tiles left after an interrupted run: gaps of every size.
-std::vector<std::uint64_t> with_gaps(std::uint64_t tiles)
+std::vector<ListedTile> with_gaps(ListedTile tiles)
 {
-    std::vector<std::uint64_t> p;
-    for (std::uint64_t t = 0; t < tiles; ++t) {
+    std::vector<ListedTile> p;
+    for (ListedTile t = 0; t < tiles; ++t) {
         if (t % 7 != 3 && !(t >= 1000 && t < 1100) && t != 1) p.push_back(t);
     }
     return p;
 }
 
-std::vector<std::uint64_t> iota(std::uint64_t n)
+std::vector<ListedTile> iota(ListedTile n)
 {
-    std::vector<std::uint64_t> p(n);
-    for (std::uint64_t t = 0; t < n; ++t) p[t] = t;
+    std::vector<ListedTile> p(n);
+    for (ListedTile t = 0; t < n; ++t) p[t] = t;
     return p;
 }
 
 TEST_P(Schedule, EveryPendingTileOnceWithGaps)
 {
-    const std::vector<std::uint64_t> pending = with_gaps(3000);
+    const std::vector<ListedTile> pending = with_gaps(3000);
     const Outcome r = run_once(pending, settings_of(GetParam()), 0);
     EXPECT_FALSE(r.result.interrupted);
     const int ranks = world.size();
@@ -256,7 +256,7 @@ TEST_P(Schedule, BlocksAreWholeGranules)
 {
     ScheduleSettings s = settings_of(GetParam());
     s.granule = 16;
-    const std::vector<std::uint64_t> pending = iota(1000);
+    const std::vector<ListedTile> pending = iota(1000);
     // Tiles that take a moment (0.1 ms): a rank that starts late (a sanitizer, a loaded
     // machine) still finds fresh blocks in the pool rather than only tiles given back from
     // the middle of a granule, which the last check below would take for misaligned.
@@ -294,7 +294,7 @@ TEST_P(Schedule, NothingPending)
 
 TEST_P(Schedule, StopFromTheStartComputesNothing)
 {
-    const std::vector<std::uint64_t> pending = iota(100);
+    const std::vector<ListedTile> pending = iota(100);
     const Outcome r = run_once(pending, settings_of(GetParam()), 0, [](const FakeWork&) { return true; });
     EXPECT_TRUE(r.result.interrupted);
     expect_reported_once(r, pending);
@@ -306,7 +306,7 @@ TEST_P(Schedule, StopFromTheStartComputesNothing)
 void stop_on_one_rank(const Mode& mode, int stopper)
 {
     const double tile = 0.002;
-    const std::vector<std::uint64_t> pending = iota(400 * static_cast<std::uint64_t>(world.size()));
+    const std::vector<ListedTile> pending = iota(400 * static_cast<std::uint64_t>(world.size()));
     const double start = seconds();
     double stopped_at = 0;
     const Outcome r = run_once(pending, settings_of(mode), tile, [&](const FakeWork&) {
@@ -354,7 +354,7 @@ TEST_P(ScheduleTimed, ReportsArriveWithinThePeriodMidBlock)
     s.report_seconds = 0.02;
     const int ranks = world.size();
     const int computing = ranks - (GetParam().dedicated_root_ranks == 2 && ranks >= 2 ? 1 : 0);
-    const std::vector<std::uint64_t> pending = iota(300 * static_cast<std::uint64_t>(computing));
+    const std::vector<ListedTile> pending = iota(300 * static_cast<std::uint64_t>(computing));
     const Outcome r = run_once(pending, s, tile);
     expect_reported_once(r, pending);
     if (!world.is_root()) return;
@@ -383,7 +383,7 @@ TEST_P(ScheduleTimed, ReportsArriveWithinThePeriodMidBlock)
 TEST(ScheduleOneLevel, BlocksShrinkAndAreFew)
 {
     const std::uint64_t n = 20000;
-    const std::vector<std::uint64_t> pending = iota(n);
+    const std::vector<ListedTile> pending = iota(n);
     const Outcome r = run_once(pending, ScheduleSettings{}, 0);
     expect_reported_once(r, pending);
     if (!world.is_root()) return;

@@ -26,9 +26,9 @@ using testing::FakeMachine;
 
 std::uint64_t checksum_of(std::uint64_t tile) { return tile * 0x9E3779B97F4A7C15ull + 1; }
 
-std::vector<std::uint64_t> iota(std::uint64_t n)
+std::vector<ListedTile> iota(std::uint64_t n)
 {
-    std::vector<std::uint64_t> v(n);
+    std::vector<ListedTile> v(n);
     std::iota(v.begin(), v.end(), 0);
     return v;
 }
@@ -112,7 +112,7 @@ using Stop = std::function<bool(int rank, double t)>;
 
 // Runs the pool on every rank of `m`; what rank 0 records goes into the record, checked as
 // it comes: once per tile, after the rank that computed it wrote it, with its payload.
-Record run(FakeMachine& m, int ranks, std::span<const std::uint64_t> pending, const Cost& cost,
+Record run(FakeMachine& m, int ranks, std::span<const ListedTile> pending, const Cost& cost,
            const ScheduleSettings& settings, const Stop& stop = {})
 {
     Record rec(ranks);
@@ -136,7 +136,7 @@ Record run(FakeMachine& m, int ranks, std::span<const std::uint64_t> pending, co
     return rec;
 }
 
-void expect_every_tile_once(const Record& rec, std::span<const std::uint64_t> pending)
+void expect_every_tile_once(const Record& rec, std::span<const ListedTile> pending)
 {
     std::multiset<std::uint64_t> computed;
     for (const auto& v : rec.computed) computed.insert(v.begin(), v.end());
@@ -154,7 +154,7 @@ TEST(HandOut, EveryTileOnceBlocksShrinkAndAreFew)
     const int ranks = 4;
     const std::uint64_t n = 2000;
     FakeMachine m({.ranks = ranks});
-    const std::vector<std::uint64_t> pending = iota(n);
+    const std::vector<ListedTile> pending = iota(n);
     const Record rec = run(m, ranks, pending, [](std::uint64_t) { return 1e-3; }, {});
     expect_every_tile_once(rec, pending);
     const std::vector<std::uint64_t>& blocks = rec.results[0].stats.handed_out;
@@ -175,7 +175,7 @@ TEST(HandOut, EveryTileOnceBlocksShrinkAndAreFew)
 TEST(HandOut, OneRankComputesEverythingWithoutAMessage)
 {
     FakeMachine m({.ranks = 1});
-    const std::vector<std::uint64_t> pending = iota(100);
+    const std::vector<ListedTile> pending = iota(100);
     const Record rec = run(m, 1, pending, [](std::uint64_t) { return 1e-3; }, {});
     expect_every_tile_once(rec, pending);
     EXPECT_EQ(rec.results[0].stats.messages_in, 0u);
@@ -190,7 +190,7 @@ TEST(HandOut, NodeLeadersServeTheirNodes)
     FakeMachine m({.ranks = ranks, .node_ranks = 8});
     ScheduleSettings s;
     s.dedicated_root_ranks = 16;
-    const std::vector<std::uint64_t> pending = iota(6000);
+    const std::vector<ListedTile> pending = iota(6000);
     const Record rec = run(m, ranks, pending, [](std::uint64_t t) { return 1e-4 * (1 + t % 7); }, s);
     expect_every_tile_once(rec, pending);
     EXPECT_FALSE(rec.results[0].stats.computed);
@@ -221,7 +221,7 @@ TEST(GiveBack, CostlyTilesAreSharedWhenTheyCluster)
     const std::uint64_t n = 400;
     FakeMachine m({.ranks = ranks});
     const Cost cost = [n](std::uint64_t t) { return 8 * t < n ? 50e-3 : 1e-3; };
-    const std::vector<std::uint64_t> pending = iota(n);
+    const std::vector<ListedTile> pending = iota(n);
     const Record rec = run(m, ranks, pending, cost, {});
     expect_every_tile_once(rec, pending);
     double work = 0;
@@ -241,7 +241,7 @@ TEST(GiveBack, AcrossNodes)
     ScheduleSettings s;
     s.dedicated_root_ranks = 8;
     const Cost cost = [](std::uint64_t t) { return t < 150 ? 50e-3 : 1e-3; };
-    const std::vector<std::uint64_t> pending = iota(n);
+    const std::vector<ListedTile> pending = iota(n);
     const Record rec = run(m, ranks, pending, cost, s);
     expect_every_tile_once(rec, pending);
     double work = 0;
@@ -265,7 +265,7 @@ TEST(Tail, TheLastCostlyTilesEndOnDifferentRanks)
 {
     for (const auto& [ranks, dedicated] : {std::pair{3, false}, {4, true}, {5, true}}) {
         const std::uint64_t n = 20 * static_cast<std::uint64_t>(ranks);
-        const std::vector<std::uint64_t> pending = iota(n);
+        const std::vector<ListedTile> pending = iota(n);
         ScheduleSettings s;
         s.dedicated_root_ranks = dedicated ? 2 : 0;
         for (std::uint64_t i = n - 8; i < n; ++i) {
@@ -295,7 +295,7 @@ TEST(Tail, TheLastCostlyTilesEndOnDifferentRanks)
 TEST(Resume, OnlyThePendingTilesAreComputed)
 {
     const int ranks = 3;
-    std::vector<std::uint64_t> pending;
+    std::vector<ListedTile> pending;
     for (std::uint64_t t = 0; t < 3000; ++t) {
         if (t % 3 == 1 || t % 7 == 0) pending.push_back(t);
     }
@@ -307,11 +307,11 @@ TEST(Resume, OnlyThePendingTilesAreComputed)
 // The run resumed after `first`: given the tiles of `all` it did not record, in their order,
 // on a machine like its own, it records each of them once and none of `first`'s, so every
 // tile is recorded once over the two runs.
-void expect_resume_completes(const Record& first, std::span<const std::uint64_t> all, FakeMachine::Options machine,
+void expect_resume_completes(const Record& first, std::span<const ListedTile> all, FakeMachine::Options machine,
                              const Cost& cost, const ScheduleSettings& settings)
 {
-    std::vector<std::uint64_t> rest;
-    for (const std::uint64_t t : all) {
+    std::vector<ListedTile> rest;
+    for (const ListedTile t : all) {
         if (!first.recorded.contains(t)) rest.push_back(t);
     }
     FakeMachine second(machine);
@@ -328,7 +328,7 @@ TEST(Resume, StopThenResumeRecordsEveryTileOnce)
 {
     for (const int node_ranks : {0, 2}) {
         const int ranks = 6;
-        const std::vector<std::uint64_t> all = iota(3000);
+        const std::vector<ListedTile> all = iota(3000);
         const Cost cost = [](std::uint64_t t) { return 1e-3 * (1 + t % 3); };
         ScheduleSettings s;
         s.report_seconds = 0.05;
@@ -357,7 +357,7 @@ TEST(LostRank, OnlyTilesNeverRecordedAreComputedAgain)
 {
     for (const int node_ranks : {0, 4}) {
         const int ranks = 8;
-        const std::vector<std::uint64_t> all = iota(4000);
+        const std::vector<ListedTile> all = iota(4000);
         const Cost cost = [](std::uint64_t t) { return 1e-3 * (1 + t % 4); };
         ScheduleSettings s;
         s.report_seconds = 0.1;

@@ -163,7 +163,7 @@ using Stop = std::function<bool(int rank, double t)>;
 
 // Runs the pool on every rank of `m` with writers; rank 0 grants space in stripes of 512
 // bytes and writes its own share as it comes.
-Record run(FakeMachine& m, int ranks, std::span<const std::uint64_t> pending, const ScheduleSettings& settings,
+Record run(FakeMachine& m, int ranks, std::span<const ListedTile> pending, const ScheduleSettings& settings,
            const Stop& stop = {})
 {
     Record rec(ranks);
@@ -208,14 +208,14 @@ Record run(FakeMachine& m, int ranks, std::span<const std::uint64_t> pending, co
     return rec;
 }
 
-std::vector<std::uint64_t> iota(std::uint64_t n)
+std::vector<ListedTile> iota(std::uint64_t n)
 {
-    std::vector<std::uint64_t> v(n);
+    std::vector<ListedTile> v(n);
     for (std::uint64_t i = 0; i < n; ++i) v[i] = i;
     return v;
 }
 
-void expect_recorded_once(const Record& rec, std::span<const std::uint64_t> pending)
+void expect_recorded_once(const Record& rec, std::span<const ListedTile> pending)
 {
     std::multiset<std::uint64_t> computed;
     for (const auto& v : rec.computed) computed.insert(v.begin(), v.end());
@@ -242,7 +242,7 @@ void expect_disjoint_grants(const Record& rec)
 TEST(Writers, EveryTileWrittenOnceByAsManyWritersAsAsked)
 {
     const int ranks = 32;
-    const std::vector<std::uint64_t> pending = iota(3000);
+    const std::vector<ListedTile> pending = iota(3000);
     const std::vector<int> each{0, 4, 8, 12, 16, 20, 24, 28}, three{0, 0, 0, 12, 12, 12, 24, 24}, one(8, 0);
     // Asked, auto from, writers, the writer of each node.
     for (const auto& [asked, auto_from, expected, writer_of_node] :
@@ -292,7 +292,7 @@ TEST(Writers, OneNodeHasOneWriter)
         FakeMachine m({.ranks = 6, .node_ranks = node_ranks});
         ScheduleSettings s;
         s.writers = 4;
-        const std::vector<std::uint64_t> pending = iota(500);
+        const std::vector<ListedTile> pending = iota(500);
         const Record rec = run(m, 6, pending, s);
         expect_recorded_once(rec, pending);
         EXPECT_EQ(rec.writers(), std::set<int>{0});
@@ -305,7 +305,7 @@ TEST(Writers, OneNodeHasOneWriter)
 TEST(Writers, StopOrLossThenResumeRecordsEveryTileOnce)
 {
     const int ranks = 12;
-    const std::vector<std::uint64_t> all = iota(2000);
+    const std::vector<ListedTile> all = iota(2000);
     ScheduleSettings s;
     s.report_seconds = 0.05;
     s.writers = 3;
@@ -324,8 +324,8 @@ TEST(Writers, StopOrLossThenResumeRecordsEveryTileOnce)
             for (const auto& v : a.computed) computed += v.size();
             EXPECT_EQ(computed, a.recorded.size());
         }
-        std::vector<std::uint64_t> rest;
-        for (const std::uint64_t t : all) {
+        std::vector<ListedTile> rest;
+        for (const ListedTile t : all) {
             if (!a.recorded.contains(t)) rest.push_back(t);
         }
         FakeMachine second({.ranks = ranks, .node_ranks = 3});
