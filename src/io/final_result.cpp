@@ -59,8 +59,8 @@ FinishReport finish_result(const fs::path& partial, const fs::path& output, cons
         }
         h5::write_attribute(file.file(), layout::kind_attribute, layout::kind_result);
         write_run_figures(file.file(), run);
-        h5::check(H5Adelete(file.file(), "tile_shape"), "H5Adelete tile_shape");
-        h5::check(H5Ldelete(file.file(), "/progress", H5P_DEFAULT), "H5Ldelete /progress");
+        h5::delete_attribute(file.file(), "tile_shape");
+        h5::unlink(file.file(), "/progress");
         file.close();
     }
     // The result takes its name only now, whole; then the undo log goes.

@@ -571,4 +571,56 @@ void read_rows(hid_t dataset, hsize_t first, hsize_t rows, std::span<std::uint64
     check(H5Dread(dataset, H5T_NATIVE_UINT64, memory, space, H5P_DEFAULT, out.data()), "read " + what);
 }
 
+Id create_dataset(hid_t loc, const std::string& path, hid_t type, const std::vector<hsize_t>& dims, const Creation& how)
+{
+    const Id space = dims.empty() ? space_id(H5Screate(H5S_SCALAR), "H5Screate") : simple_space(dims);
+    const Id dcpl = plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
+    if (!how.chunk.empty()) check(H5Pset_chunk(dcpl, static_cast<int>(how.chunk.size()), how.chunk.data()), "H5Pset_chunk");
+    if (how.deflate > 0) {
+        check(H5Pset_shuffle(dcpl), "H5Pset_shuffle");
+        check(H5Pset_deflate(dcpl, static_cast<unsigned>(how.deflate)), "H5Pset_deflate");
+    }
+    check(H5Pset_alloc_time(dcpl, how.alloc), "H5Pset_alloc_time");
+    if (how.fill) check(H5Pset_fill_time(dcpl, *how.fill), "H5Pset_fill_time");
+    return dataset_id(H5Dcreate2(loc, path.c_str(), type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), "create " + path);
+}
+
+std::size_t type_size(hid_t type)
+{
+    const std::size_t n = H5Tget_size(type);
+    if (n == 0) throw Error("H5Tget_size failed");
+    return n;
+}
+
+std::optional<std::pair<std::uint64_t, std::uint64_t>> contiguous_range(hid_t dataset)
+{
+    const haddr_t at = H5Dget_offset(dataset);
+    if (at == HADDR_UNDEF) return std::nullopt;
+    return std::pair<std::uint64_t, std::uint64_t>{at, H5Dget_storage_size(dataset)};
+}
+
+std::uint64_t allocated_chunks(hid_t dataset)
+{
+    hsize_t chunks = 0;
+    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space");
+    check(H5Dget_num_chunks(dataset, space, &chunks), "H5Dget_num_chunks");
+    return chunks;
+}
+
+std::optional<std::vector<std::byte>> read_raw_chunk(hid_t dataset, const std::vector<hsize_t>& origin, std::uint64_t bytes)
+{
+    hsize_t stored = 0;
+    if (H5Dget_chunk_storage_size(dataset, origin.data(), &stored) < 0 || stored != bytes) return std::nullopt;
+    std::vector<std::byte> chunk(stored);
+    std::uint32_t filters = 0;
+    if (H5Dread_chunk(dataset, H5P_DEFAULT, origin.data(), &filters, chunk.data()) < 0) return std::nullopt;
+    return chunk;
+}
+
+void flush(hid_t file) { check(H5Fflush(file, H5F_SCOPE_GLOBAL), "H5Fflush"); }
+
+void delete_attribute(hid_t obj, const std::string& name) { check(H5Adelete(obj, name.c_str()), "H5Adelete " + name); }
+
+void unlink(hid_t loc, const std::string& path) { check(H5Ldelete(loc, path.c_str(), H5P_DEFAULT), "H5Ldelete " + path); }
+
 }  // namespace superball::h5

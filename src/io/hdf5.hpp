@@ -89,6 +89,59 @@ std::uint64_t contiguous_offset(hid_t dataset);
 // Byte offset of the chunk whose first element is at `coords`.
 std::uint64_t chunk_offset(hid_t dataset, const std::vector<hsize_t>& coords);
 
+// ------------------------------------------------------------------------------- datasets
+
+// How a new dataset is stored (its creation properties).
+struct Creation {
+    std::vector<hsize_t> chunk;  // empty: contiguous
+    int deflate = 0;             // above 0: shuffle, then deflate at this level
+    H5D_alloc_time_t alloc = H5D_ALLOC_TIME_EARLY;
+    std::optional<H5D_fill_time_t> fill;  // HDF5's default unless set
+};
+// Dataset `path` in `loc` of file type `type` and dimensions `dims` (empty: a scalar).
+Id create_dataset(hid_t loc, const std::string& path, hid_t type, const std::vector<hsize_t>& dims, const Creation& how);
+// Bytes of one element of a datatype.
+std::size_t type_size(hid_t type);
+// A contiguous dataset's data in its file: [offset, offset + bytes), nullopt if unallocated.
+std::optional<std::pair<std::uint64_t, std::uint64_t>> contiguous_range(hid_t dataset);
+// Chunks a chunked dataset has allocated.
+std::uint64_t allocated_chunks(hid_t dataset);
+// The chunk whose first element is at `origin` as stored (through no filter), if it is
+// stored in exactly `bytes` bytes and can be read; nullopt otherwise.
+std::optional<std::vector<std::byte>> read_raw_chunk(hid_t dataset, const std::vector<hsize_t>& origin, std::uint64_t bytes);
+void flush(hid_t file);
+void delete_attribute(hid_t obj, const std::string& name);
+// Removes the link `path` of `loc` (the object goes with its last link).
+void unlink(hid_t loc, const std::string& path);
+
+// Typed reads and writes (HighFive's shape): T's native memory type, converted from and to
+// the file's by HDF5; `what` names the data in errors.
+template <class T>
+hid_t native_type()
+{
+    if constexpr (std::is_same_v<T, std::uint8_t>) return H5T_NATIVE_UINT8;
+    else if constexpr (std::is_same_v<T, std::uint32_t>) return H5T_NATIVE_UINT32;
+    else if constexpr (std::is_same_v<T, std::uint64_t>) return H5T_NATIVE_UINT64;
+    else if constexpr (std::is_same_v<T, double>) return H5T_NATIVE_DOUBLE;
+    else static_assert(sizeof(T) == 0, "no native HDF5 type for this element type");
+}
+// The whole dataset into `out` (its elements in row-major order; out.size() of them).
+template <class T>
+void read(hid_t dataset, std::span<T> out, const std::string& what)
+{
+    check(H5Dread(dataset, native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), "read " + what);
+}
+// `in` as the whole dataset.
+template <class T>
+void write(hid_t dataset, std::span<const T> in, const std::string& what)
+{
+    check(H5Dwrite(dataset, native_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, in.data()), "write " + what);
+}
+// The box [start, start + count) of a dataset into `out` (row-major over the box).
+template <class T>
+void read_box(hid_t dataset, const std::vector<hsize_t>& start, const std::vector<hsize_t>& count, std::span<T> out,
+              const std::string& what);
+
 // --------------------------------------------------------------------------- attributes
 
 // Scalar and 1-D attributes on an object; an existing attribute of the name is replaced.
@@ -148,5 +201,15 @@ Id simple_space(const std::vector<hsize_t>& dims);
 // Rows [first, first + rows) of a dataset of one or two dimensions, every column, as
 // unsigned 64-bit integers, into `out` (rows x columns values); `what` names it in errors.
 void read_rows(hid_t dataset, hsize_t first, hsize_t rows, std::span<std::uint64_t> out, const std::string& what);
+
+template <class T>
+void read_box(hid_t dataset, const std::vector<hsize_t>& start, const std::vector<hsize_t>& count, std::span<T> out,
+              const std::string& what)
+{
+    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space " + what);
+    select_box(space, start, count);
+    const Id memory = simple_space(count);
+    check(H5Dread(dataset, native_type<T>(), memory, space, H5P_DEFAULT, out.data()), "read " + what);
+}
 
 }  // namespace superball::h5

@@ -34,29 +34,16 @@ std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
 // indexed where rank 0 appended them when the run completes.
 void create_tiled(hid_t file, const char* name, hid_t type, const Tiling& tiling, int level)
 {
-    const h5::Id space = h5::simple_space(to_hsize(tiling.shape()));
-    const auto chunk = to_hsize(tiling.tile_shape());
-    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
-    h5::check(H5Pset_chunk(dcpl, static_cast<int>(chunk.size()), chunk.data()), "H5Pset_chunk");
-    if (level > 0) {
-        h5::check(H5Pset_shuffle(dcpl), "H5Pset_shuffle");
-        h5::check(H5Pset_deflate(dcpl, static_cast<unsigned>(level)), "H5Pset_deflate");
-        h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_INCR), "H5Pset_alloc_time");
-    } else {
-        h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
-    }
-    h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER), "H5Pset_fill_time");
-    h5::dataset_id(H5Dcreate2(file, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
+    h5::create_dataset(file, name, type, to_hsize(tiling.shape()),
+                       {to_hsize(tiling.tile_shape()), level, level > 0 ? H5D_ALLOC_TIME_INCR : H5D_ALLOC_TIME_EARLY,
+                        H5D_FILL_TIME_NEVER});
 }
 
 // A contiguous dataset of one row per tile, zeros (no tile done yet).
 void create_journal(hid_t loc, const char* name, hid_t type, hsize_t n, hsize_t per_tile = 1)
 {
-    const h5::Id space = h5::simple_space(per_tile == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, per_tile});
-    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
-    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
-    h5::check(H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC), "H5Pset_fill_time");
-    h5::dataset_id(H5Dcreate2(loc, name, type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), name);
+    h5::create_dataset(loc, name, type, per_tile == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, per_tile},
+                       {{}, 0, H5D_ALLOC_TIME_EARLY, H5D_FILL_TIME_ALLOC});
 }
 
 // Chunk `t`'s first element, as dataset coordinates.
@@ -148,7 +135,7 @@ PartialLayout create_partial(const std::filesystem::path& path, const Job& job, 
     }
     h5::write_attribute(file, "tile_shape", tiling.tile_shape());
     PartialLayout l = layout_of(file, tiling);
-    h5::check(H5Fflush(file, H5F_SCOPE_GLOBAL), "H5Fflush");
+    h5::flush(file);
     return l;
 }
 

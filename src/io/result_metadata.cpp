@@ -21,18 +21,14 @@ void describe_variable(hid_t d, const std::string& name)
 // require it of datasets written independently).
 h5::Id create_doubles(hid_t file, const std::string& name, const std::vector<hsize_t>& dims)
 {
-    const h5::Id space = dims.empty() ? h5::space_id(H5Screate(H5S_SCALAR), "H5Screate") : h5::simple_space(dims);
-    const h5::Id dcpl = h5::plist_id(H5Pcreate(H5P_DATASET_CREATE), "H5Pcreate");
-    h5::check(H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY), "H5Pset_alloc_time");
-    return h5::dataset_id(H5Dcreate2(file, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
-                          "create " + name);
+    return h5::create_dataset(file, name, H5T_IEEE_F64LE, dims, {});
 }
 
 }  // namespace
 
 hid_t count_type(const Job& job) { return job.max_bounces > 65535 ? H5T_STD_U32LE : H5T_STD_U16LE; }
 
-std::size_t count_bytes(const Job& job) { return H5Tget_size(count_type(job)); }
+std::size_t count_bytes(const Job& job) { return h5::type_size(count_type(job)); }
 
 ResultInfo result_info(const Job& job, const Grid& grid)
 {
@@ -44,7 +40,7 @@ ResultInfo result_info(const Job& job, const Grid& grid)
         if (!c.is_range()) info.fixed.emplace_back(c.name, *c.fixed);
     }
     info.shape = grid.shape();
-    info.count_bytes = H5Tget_size(count_type(job));
+    info.count_bytes = count_bytes(job);
     info.job_toml = job.text;
     info.job_fingerprint = fingerprint(job);
     info.software_version = software_version;
@@ -65,7 +61,7 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
         const std::vector<double>& s = grid.samples(k);
         h5::Id d = create_doubles(file, "/" + name, {s.size()});
         if (write_samples) {
-            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.data()), "write /" + name);
+            h5::write(d, std::span(s), "/" + name);
         }
         describe_variable(d, name);
         h5::make_dimension_scale(d, name);
@@ -77,7 +73,7 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
         if (c.is_range()) continue;
         const h5::Id d = create_doubles(file, "/" + c.name, {});
         if (write_samples) {
-            h5::check(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &*c.fixed), "write /" + c.name);
+            h5::write(d, std::span<const double>(&*c.fixed, 1), "/" + c.name);
         }
         describe_variable(d, c.name);
         h5::write_attribute(file, "fixed_" + c.name, *c.fixed);

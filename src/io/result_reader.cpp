@@ -313,7 +313,7 @@ std::vector<std::pair<std::uint64_t, std::uint64_t>> raw_data_ranges(hid_t file)
             const h5::Shape s = h5::dataset_shape_of(d);
             const h5::Storage st = h5::dataset_storage(d);
             if (st.chunk.empty()) {
-                if (const haddr_t at = H5Dget_offset(d); at != HADDR_UNDEF) ranges.emplace_back(at, H5Dget_storage_size(d));
+                if (const auto range = h5::contiguous_range(d)) ranges.push_back(*range);
                 continue;
             }
             // (A result's compressed chunks are searched: HDF5 1.10 finds a chunk's address by
@@ -588,8 +588,7 @@ void ResultReader::validate_no_journal()
             if (s.type == h5::TypeClass::integer && s.bytes == 1 && s.dims.size() == 1 && s.dims[0] <= max_points &&
                 h5::dataset_storage(d).allocated) {
                 std::vector<std::uint8_t> flags(s.dims[0]);
-                h5::check(H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, flags.data()),
-                          "read " + std::string(layout::tile_done));
+                h5::read(d, std::span(flags), layout::tile_done);
                 journal = fmt::format(", /progress/tile_done, recording {} of {} tiles done", std::count(flags.begin(), flags.end(), 1),
                                       flags.size());
             }
@@ -703,7 +702,7 @@ void ResultReader::validate_coordinates()
         }
         check.allocated(d, v);
         double x = 0;
-        h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, &x), "read " + v);
+        h5::read(d, std::span(&x, 1), v);
         if (!(x == value)) check.fail(fmt::format("{} = {} contradicts attribute fixed_{} = {}", v, x, name, value));
     }
 }
@@ -749,10 +748,7 @@ void ResultReader::validate_tiles()
         if (!compressed_) {
             check.allocated(d, name);
         } else {
-            hsize_t chunks = 0;
-            const h5::Id space = h5::space_id(H5Dget_space(d), "H5Dget_space");
-            h5::check(H5Dget_num_chunks(d, space, &chunks), "H5Dget_num_chunks");
-            if (chunks != 0) {
+            if (const std::uint64_t chunks = h5::allocated_chunks(d); chunks != 0) {
                 check.fail(fmt::format("{} holds chunks ({}), which a compressed partial file never does: its tiles are "
                                        "in /progress/tile_stored until the run completes; the file is damaged",
                                        name, chunks));
@@ -780,9 +776,7 @@ void ResultReader::validate_journal()
         check.allocated(d, name);
     }
     done_.resize(in.tiles);
-    h5::check(H5Dread(h5::open_dataset(file_, layout::tile_done), H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                      done_.data()),
-              "read " + std::string(layout::tile_done));
+    h5::read(h5::open_dataset(file_, layout::tile_done), std::span(done_), layout::tile_done);
     for (std::uint64_t t = 0; t < in.tiles; ++t) {
         if (done_[t] > 1) check.fail(fmt::format("{} holds {} for tile {}: accepted 0 or 1", layout::tile_done, done_[t], t));
     }
@@ -831,7 +825,7 @@ std::vector<double> ResultReader::axis(std::size_t k) const
         }
         check.allocated(d, name);
         std::vector<double> v(info_.shape[k]);
-        h5::check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), "read " + name);
+        h5::read(d, std::span(v), name);
         for (std::size_t i = 0; i < v.size(); ++i) {
             if (!std::isfinite(v[i])) check.fail(fmt::format("{} holds {} at {}: samples must be finite", name, v[i], i));
             if (i > 0 && !(v[i] > v[i - 1])) {
@@ -915,16 +909,9 @@ bool ResultReader::tile_intact(std::uint64_t t) const
     const std::vector<hsize_t> origin = to_hsize(tiling_->box(t).start);
     std::uint64_t chunk_points = 1;
     for (const std::uint64_t n : info_.tile_shape) chunk_points *= n;
-    std::vector<std::byte> counts, outcomes;
-    for (auto [d, buf, bytes] : {std::tuple{counts_.get(), &counts, info_.count_bytes},
-                                 std::tuple{outcomes_.get(), &outcomes, std::size_t{1}}}) {
-        hsize_t stored = 0;
-        if (H5Dget_chunk_storage_size(d, origin.data(), &stored) < 0 || stored != chunk_points * bytes) return false;
-        buf->resize(stored);
-        std::uint32_t filters = 0;
-        if (H5Dread_chunk(d, H5P_DEFAULT, origin.data(), &filters, buf->data()) < 0) return false;
-    }
-    return tile_checksum(t, counts, outcomes) == sums_[t];
+    const std::optional<std::vector<std::byte>> counts = h5::read_raw_chunk(counts_.get(), origin, chunk_points * info_.count_bytes);
+    const std::optional<std::vector<std::byte>> outcomes = h5::read_raw_chunk(outcomes_.get(), origin, chunk_points);
+    return counts && outcomes && tile_checksum(t, *counts, *outcomes) == sums_[t];
 }
 
 std::vector<std::uint64_t> ResultReader::damaged_tiles() const
@@ -1003,17 +990,11 @@ std::uint64_t ResultReader::read_checked(const Box& box, std::span<std::uint32_t
                                          std::span<std::uint8_t> outcomes) const
 {
     const std::vector<hsize_t> start = to_hsize(box.start), count = to_hsize(box.count);
-    const h5::Id memory = h5::simple_space(count);
-    if (compressed_) read_stored(box, counts, outcomes);
-    for (const hid_t d : {counts_.get(), outcomes_.get()}) {
-        if (compressed_) break;
-        const h5::Id space = h5::space_id(H5Dget_space(d), "H5Dget_space");
-        h5::select_box(space, start, count);
-        if (d == counts_.get()) {
-            h5::check(H5Dread(d, H5T_NATIVE_UINT32, memory, space, H5P_DEFAULT, counts.data()), "read /wall_bounces");
-        } else {
-            h5::check(H5Dread(d, H5T_NATIVE_UINT8, memory, space, H5P_DEFAULT, outcomes.data()), "read /outcome");
-        }
+    if (compressed_) {
+        read_stored(box, counts, outcomes);
+    } else {
+        h5::read_box(counts_.get(), start, count, counts, layout::wall_bounces);
+        h5::read_box(outcomes_.get(), start, count, outcomes, layout::outcome);
     }
     // Points of tiles not done hold whatever the disk held: mask them, a run of a row at a
     // time (a row of the box crosses a tile every tile_shape.back() points).
