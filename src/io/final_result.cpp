@@ -59,7 +59,7 @@ FinishReport finish_result(const fs::path& partial, const fs::path& output, cons
         }
         h5::write_attribute(file.file(), layout::kind_attribute, layout::kind_result);
         write_run_figures(file.file(), run);
-        h5::delete_attribute(file.file(), "tile_shape");
+        h5::delete_attribute(file.file(), layout::attr::tile_shape);
         h5::unlink(file.file(), "/progress");
         file.close();
     }

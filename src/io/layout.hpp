@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace superball::layout {
 
@@ -33,7 +34,53 @@ namespace superball::layout {
 inline constexpr std::int64_t format_version = 3;
 inline constexpr std::int64_t oldest_result_format = 2;
 
-inline constexpr const char* kind_attribute = "superball_file";
+// The attributes of a file, each name and type written once here and used by the writers
+// (result_metadata.cpp, partial_file.cpp, final_result.cpp) and the reader
+// (result_reader.cpp). Text: fixed-length ASCII (netCDF's NC_CHAR, for CF's descriptive
+// attributes); std::string: a variable-length string.
+struct Text {};
+template <class T>
+struct Attribute {
+    const char* name;
+    operator std::string() const { return name; }  // where only the name is wanted
+};
+namespace attr {
+// At the root of both kinds of file.
+inline constexpr Attribute<std::string> kind{"superball_file"};  // kind_result or kind_partial
+inline constexpr Attribute<std::int64_t> format{"superball_format"};  // format_version
+inline constexpr Attribute<Text> conventions{"Conventions"};
+inline constexpr Attribute<Text> title{"title"};
+inline constexpr Attribute<Text> source{"source"};
+inline constexpr Attribute<Text> date_created{"date_created"};
+inline constexpr Attribute<Text> build{"build"};
+inline constexpr Attribute<std::string> coordinate_system{"coordinate_system"};  // canonical or physical
+inline constexpr Attribute<std::vector<std::string>> axis_names{"axis_names"};
+inline constexpr const char* fixed_prefix = "fixed_";  // fixed_<coordinate>: double
+inline constexpr Attribute<std::vector<std::string>> swept{"swept"};
+inline constexpr Attribute<double> g{"g"};  // physical grids
+inline constexpr Attribute<double> radius{"radius"};
+inline constexpr Attribute<std::int64_t> max_bounces{"max_bounces"};
+inline constexpr Attribute<std::int64_t> refine{"refine"};
+inline constexpr Attribute<std::string> job_toml{"job_toml"};
+inline constexpr Attribute<std::string> job_fingerprint{"job_fingerprint"};
+inline constexpr Attribute<std::string> software_version{"software_version"};
+inline constexpr Attribute<std::string> history{"history"};
+inline constexpr Attribute<std::int64_t> mpi_ranks{"mpi_ranks"};
+inline constexpr Attribute<std::int64_t> mpi_hosts{"mpi_hosts"};
+inline constexpr Attribute<std::int64_t> threads{"threads"};
+inline constexpr Attribute<double> wall_seconds{"wall_seconds"};
+inline constexpr Attribute<std::int64_t> complete{"complete"};  // 0 or 1
+// A partial file's only (the tiling its journal is of).
+inline constexpr Attribute<std::vector<std::uint64_t>> tile_shape{"tile_shape"};
+// On the variables (CF).
+inline constexpr Attribute<Text> long_name{"long_name"};
+inline constexpr Attribute<Text> units{"units"};
+inline constexpr Attribute<Text> coordinates{"coordinates"};
+inline constexpr Attribute<std::vector<std::uint8_t>> flag_values{"flag_values"};
+inline constexpr Attribute<Text> flag_meanings{"flag_meanings"};
+}  // namespace attr
+
+inline constexpr const char* kind_attribute = attr::kind.name;
 inline constexpr const char* kind_result = "result";
 inline constexpr const char* kind_partial = "partial";
 

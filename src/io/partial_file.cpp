@@ -133,7 +133,7 @@ PartialLayout create_partial(const std::filesystem::path& path, const Job& job, 
         const h5::Id outcomes = h5::open_dataset(file, layout::outcome);
         describe_data(counts, outcomes, job, axes);
     }
-    h5::write_attribute(file, "tile_shape", tiling.tile_shape());
+    h5::write_attribute(file, layout::attr::tile_shape, tiling.tile_shape());
     PartialLayout l = layout_of(file, tiling);
     h5::flush(file);
     return l;
@@ -147,7 +147,7 @@ PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& ti
 double record_partial_run(const std::filesystem::path& path, double seconds, const Provenance& run)
 {
     PlacedChunks file(path);
-    const double total = h5::read_double_attribute(file.file(), "wall_seconds") + seconds;
+    const double total = h5::read_double_attribute(file.file(), layout::attr::wall_seconds) + seconds;
     write_run_figures(file.file(), {run, total, false});
     file.close();
     PlacedChunks::discard_undo(path);

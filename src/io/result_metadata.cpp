@@ -10,11 +10,21 @@ namespace superball {
 
 namespace {
 
+namespace attr = layout::attr;
+
+// An attribute of the schema (io/layout.hpp), written with the type it states.
+template <class T>
+void put(hid_t obj, layout::Attribute<T> a, const std::type_identity_t<T>& value)
+{
+    h5::write_attribute(obj, a.name, value);
+}
+void put(hid_t obj, layout::Attribute<layout::Text> a, const std::string& value) { h5::write_text_attribute(obj, a.name, value); }
+
 void describe_variable(hid_t d, const std::string& name)
 {
     const layout::VariableText t = layout::variable_text(name);
-    h5::write_text_attribute(d, "long_name", std::string(t.long_name));
-    h5::write_text_attribute(d, "units", std::string(t.units));
+    put(d, attr::long_name, std::string(t.long_name));
+    put(d, attr::units, std::string(t.units));
 }
 
 // A small contiguous float64 dataset, its space allocated at creation (parallel files
@@ -76,21 +86,21 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
             h5::write(d, std::span<const double>(&*c.fixed, 1), "/" + c.name);
         }
         describe_variable(d, c.name);
-        h5::write_attribute(file, "fixed_" + c.name, *c.fixed);
+        h5::write_attribute(file, attr::fixed_prefix + c.name, *c.fixed);
     }
 
-    h5::write_attribute(file, layout::kind_attribute, kind);
-    h5::write_attribute(file, "superball_format", layout::format_version);
-    h5::write_text_attribute(file, "Conventions", "CF-1.8");
-    h5::write_text_attribute(file, "title", "superball: wall bounces of a superball between a floor and a wall, over a grid of launches");
+    put(file, attr::kind, kind);
+    put(file, attr::format, layout::format_version);
+    put(file, attr::conventions, "CF-1.8");
+    put(file, attr::title, "superball: wall bounces of a superball between a floor and a wall, over a grid of launches");
     // Provenance (CF and ACDD): the software and the run that created the file; history
     // (write_run_figures) has a line per run.
-    h5::write_text_attribute(file, "source", software_source());
-    h5::write_text_attribute(file, "date_created", run.run.date);
-    h5::write_text_attribute(file, "build", software_build() + (run.run.kernel.empty() ? "" : "; counting kernel " + run.run.kernel));
+    put(file, attr::source, software_source());
+    put(file, attr::date_created, run.run.date);
+    put(file, attr::build, software_build() + (run.run.kernel.empty() ? "" : "; counting kernel " + run.run.kernel));
     // Not "coordinates": that is CF's keyword for auxiliary coordinates, which xarray takes.
-    h5::write_attribute(file, "coordinate_system", std::string(name(job.coordinates)));
-    h5::write_attribute(file, "axis_names", axis_names);
+    put(file, attr::coordinate_system, std::string(name(job.coordinates)));
+    put(file, attr::axis_names, axis_names);
     // A swept coefficient has no single value: its attribute names the axis instead
     // ("axis:e"), and `swept` lists the coefficient axes.
     const std::pair<const char*, double> coefficients[] = {{"e_wall", job.model.wall.e},
@@ -108,49 +118,49 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
     if (!job.parameters.empty()) {
         std::vector<std::string> swept;
         for (const Coordinate& p : job.parameters) swept.push_back(p.name);
-        h5::write_attribute(file, "swept", swept);
+        put(file, attr::swept, swept);
     }
     if (job.coordinates == Coordinates::physical) {
-        h5::write_attribute(file, "g", job.frame.g);
-        h5::write_attribute(file, "radius", job.frame.radius);
+        put(file, attr::g, job.frame.g);
+        put(file, attr::radius, job.frame.radius);
     }
-    h5::write_attribute(file, "max_bounces", static_cast<std::int64_t>(job.max_bounces));
+    put(file, attr::max_bounces, job.max_bounces);
     // 0: every point computed; s: adaptive refinement from every s-th point.
-    h5::write_attribute(file, "refine", static_cast<std::int64_t>(job.refine));
-    h5::write_attribute(file, "job_toml", job.text);
-    h5::write_attribute(file, "job_fingerprint", fingerprint(job));
-    h5::write_attribute(file, "software_version", std::string(software_version));
+    put(file, attr::refine, job.refine);
+    put(file, attr::job_toml, job.text);
+    put(file, attr::job_fingerprint, fingerprint(job));
+    put(file, attr::software_version, std::string(software_version));
     write_run_figures(file, run);
     return axes;
 }
 
 void describe_data(hid_t wall_bounces, hid_t outcome, const Job& job, const std::vector<h5::Id>& axes)
 {
-    h5::write_text_attribute(wall_bounces, "long_name", "wall impacts before the motion ended, or max_bounces (capped)");
-    h5::write_text_attribute(wall_bounces, "units", "1");
-    h5::write_text_attribute(outcome, "long_name", "how the motion ended");
-    h5::write_attribute(outcome, "flag_values", std::span<const std::uint8_t>(layout::outcome_codes));
-    h5::write_text_attribute(outcome, "flag_meanings", layout::outcome_meanings);
+    put(wall_bounces, attr::long_name, "wall impacts before the motion ended, or max_bounces (capped)");
+    put(wall_bounces, attr::units, "1");
+    put(outcome, attr::long_name, "how the motion ended");
+    h5::write_attribute(outcome, attr::flag_values.name, std::span<const std::uint8_t>(layout::outcome_codes));
+    put(outcome, attr::flag_meanings, layout::outcome_meanings);
     std::string fixed;
     for (const Coordinate& c : job.grid) {
         if (!c.is_range()) fixed += (fixed.empty() ? "" : " ") + c.name;
     }
     for (const hid_t d : {wall_bounces, outcome}) {
-        if (!fixed.empty()) h5::write_text_attribute(d, "coordinates", fixed);
+        if (!fixed.empty()) put(d, attr::coordinates, fixed);
         for (std::size_t k = 0; k < axes.size(); ++k) h5::attach_dimension_scale(d, axes[k], static_cast<unsigned>(k));
     }
 }
 
 void write_run_figures(hid_t file, const RunFigures& run)
 {
-    const std::string before = h5::has_attribute(file, "history") ? h5::read_string_attribute(file, "history") : "";
+    const std::string before = h5::has_attribute(file, attr::history) ? h5::read_string_attribute(file, attr::history) : "";
     // UTF-8 (a command line may name any path), as job_toml.
-    h5::write_attribute(file, "history", append_history(before, history_line(run.run)));
-    h5::write_attribute(file, "mpi_ranks", run.run.mpi_ranks);
-    h5::write_attribute(file, "mpi_hosts", run.run.hosts);
-    h5::write_attribute(file, "threads", run.run.threads);
-    h5::write_attribute(file, "wall_seconds", run.wall_seconds);
-    h5::write_attribute(file, "complete", std::int64_t{run.complete ? 1 : 0});
+    put(file, attr::history, append_history(before, history_line(run.run)));
+    put(file, attr::mpi_ranks, run.run.mpi_ranks);
+    put(file, attr::mpi_hosts, run.run.hosts);
+    put(file, attr::threads, run.run.threads);
+    put(file, attr::wall_seconds, run.wall_seconds);
+    put(file, attr::complete, run.complete ? 1 : 0);
 }
 
 }  // namespace superball

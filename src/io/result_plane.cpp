@@ -6,6 +6,7 @@
 
 #include "core/input.hpp"
 #include "job/job.hpp"
+#include "layout.hpp"
 #include "result_reader.hpp"
 
 namespace superball {
@@ -19,7 +20,7 @@ double cell_size(const ResultReader& reader, std::size_t k)
     const std::vector<double> s = reader.axis(k);
     if (s.size() >= 2) return (s.back() - s.front()) / static_cast<double>(s.size() - 1);
     try {
-        const Job job = parse_job(reader.info().job_toml, "job_toml");
+        const Job job = parse_job(reader.info().job_toml, layout::attr::job_toml.name);
         for (const Coordinate* c : job.range_axes()) {
             if (c->name == reader.info().axis_names[k]) return (c->range->max - c->range->min) / static_cast<double>(c->range->n);
         }

@@ -22,6 +22,7 @@
 namespace superball {
 
 namespace fs = std::filesystem;
+namespace attr = layout::attr;
 
 namespace {
 
@@ -360,7 +361,7 @@ FileIdentity identify_file(const fs::path& path)
         std::string why;
         try {
             const h5::Id f = h5::open_file(path, false);
-            if (h5::has_attribute(f, layout::kind_attribute) || h5::has_attribute(f, "job_toml")) {
+            if (h5::has_attribute(f, layout::kind_attribute) || h5::has_attribute(f, attr::job_toml)) {
                 return {true, "a superball file"};
             }
             why = "it opens, but has none of superball's attributes";
@@ -423,13 +424,13 @@ void ResultReader::validate_kind()
     // What the file is.
     if (!h5::has_attribute(file_, layout::kind_attribute)) {
         // Attributes only this layout has: the file is of this layout, damaged.
-        if (h5::has_attribute(file_, "superball_format") || h5::has_attribute(file_, "coordinate_system")) {
+        if (h5::has_attribute(file_, attr::format) || h5::has_attribute(file_, attr::coordinate_system)) {
             check.fail("attribute " + std::string(layout::kind_attribute) + " is missing");
         }
-        if (h5::has_attribute(file_, "job_toml") && h5::has_attribute(file_, "software_version")) {
+        if (h5::has_attribute(file_, attr::job_toml) && h5::has_attribute(file_, attr::software_version)) {
             std::string version = "?";
             try {
-                version = h5::read_string_attribute(file_, "software_version");
+                version = h5::read_string_attribute(file_, attr::software_version);
             } catch (const h5::Error&) {
             }
             check.fail("written by superball " + printable(version) +
@@ -444,7 +445,7 @@ void ResultReader::validate_kind()
                                layout::kind_result, layout::kind_partial));
     }
     in.kind = kind == layout::kind_result ? FileKind::result : FileKind::partial;
-    if (const std::int64_t format = check.integer("superball_format", 0, std::numeric_limits<std::int64_t>::max());
+    if (const std::int64_t format = check.integer(attr::format, 0, std::numeric_limits<std::int64_t>::max());
         format != layout::format_version && !(in.kind == FileKind::result && format >= layout::oldest_result_format &&
                                               format < layout::format_version)) {
         check.fail(in.kind == FileKind::result
@@ -462,12 +463,12 @@ void ResultReader::validate_axes()
 {
     const Checker check(file_, path_);
     ResultInfo& in = info_;
-    in.coordinate_system = check.text("coordinate_system");
+    in.coordinate_system = check.text(attr::coordinate_system);
     if (in.coordinate_system != "canonical" && in.coordinate_system != "physical") {
         check.fail("attribute coordinate_system = \"" + printable(in.coordinate_system) + "\" is neither canonical nor physical");
     }
     const std::vector<std::string> coordinates = coordinates_of(in.coordinate_system);
-    in.axis_names = check.texts("axis_names", 4);
+    in.axis_names = check.texts(attr::axis_names, 4);
     std::set<std::string> seen;
     std::ptrdiff_t last_coordinate = -1;
     for (const std::string& a : in.axis_names) {
@@ -489,7 +490,7 @@ void ResultReader::validate_axes()
     }
     for (const std::string& c : coordinates) {
         if (std::find(in.axis_names.begin(), in.axis_names.end(), c) == in.axis_names.end()) {
-            in.fixed.emplace_back(c, check.number("fixed_" + c));
+            in.fixed.emplace_back(c, check.number(attr::fixed_prefix + c));
         }
     }
     if (in.fixed.size() + 3 < coordinates.size()) {
@@ -503,19 +504,19 @@ void ResultReader::validate_job_and_model()
 {
     const Checker check(file_, path_);
     ResultInfo& in = info_;
-    in.max_bounces = check.integer("max_bounces", 1, max_max_bounces);
-    in.software_version = check.text("software_version");
-    in.job_toml = check.text("job_toml", max_job_bytes);
+    in.max_bounces = check.integer(attr::max_bounces, 1, max_max_bounces);
+    in.software_version = check.text(attr::software_version);
+    in.job_toml = check.text(attr::job_toml, max_job_bytes);
     // The job is printed and resumed from: a damaged text (its bytes sit in HDF5's global
     // heap, which has no checksum) is refused, not shown.
     try {
-        parse_job(in.job_toml, "job_toml");
+        parse_job(in.job_toml, attr::job_toml.name);
     } catch (const InputError& e) {
         check.fail(fmt::format("attribute job_toml is not the text of a valid job ({}): the file is damaged",
                                printable(e.what())));
     }
-    in.job_fingerprint = check.text("job_fingerprint", max_job_bytes);
-    in.mpi_ranks = check.integer("mpi_ranks", 0, std::int64_t{1} << 40);
+    in.job_fingerprint = check.text(attr::job_fingerprint, max_job_bytes);
+    in.mpi_ranks = check.integer(attr::mpi_ranks, 0, std::int64_t{1} << 40);
     // Provenance, in files of superball 0.1.0 from commit-recording builds on: optional.
     // Printed by info as they are: damaged bytes are refused, not shown.
     const auto optional_text = [&](const char* key, std::size_t max_bytes) {
@@ -524,15 +525,15 @@ void ResultReader::validate_job_and_model()
         if (!printable_lines(v)) check.fail(fmt::format("attribute {} = \"{}\" is not UTF-8 text: the file is damaged", key, printable(v)));
         return v;
     };
-    in.history = optional_text("history", max_job_bytes);
-    in.source = optional_text("source", max_text_bytes);
-    in.date_created = optional_text("date_created", max_text_bytes);
-    in.build = optional_text("build", max_text_bytes);
-    if (h5::has_attribute(file_, "mpi_hosts")) in.mpi_hosts = check.integer("mpi_hosts", 1, std::int64_t{1} << 40);
-    if (h5::has_attribute(file_, "threads")) in.threads = check.integer("threads", 1, std::int64_t{1} << 20);
-    in.wall_seconds = check.number("wall_seconds");
+    in.history = optional_text(attr::history.name, max_job_bytes);
+    in.source = optional_text(attr::source.name, max_text_bytes);
+    in.date_created = optional_text(attr::date_created.name, max_text_bytes);
+    in.build = optional_text(attr::build.name, max_text_bytes);
+    if (h5::has_attribute(file_, attr::mpi_hosts)) in.mpi_hosts = check.integer(attr::mpi_hosts, 1, std::int64_t{1} << 40);
+    if (h5::has_attribute(file_, attr::threads)) in.threads = check.integer(attr::threads, 1, std::int64_t{1} << 20);
+    in.wall_seconds = check.number(attr::wall_seconds);
     if (in.wall_seconds < 0) check.fail(fmt::format("attribute wall_seconds = {} is negative", in.wall_seconds));
-    in.complete = check.integer("complete", 0, 1) == 1;
+    in.complete = check.integer(attr::complete, 0, 1) == 1;
     if (in.kind == FileKind::result && !in.complete) {
         check.fail("attribute complete = 0 contradicts superball_file = result (a result is written complete)");
     }
@@ -567,7 +568,7 @@ void ResultReader::validate_job_and_model()
         }
     }
     if (in.coordinate_system == "physical") {
-        for (const char* key : {"g", "radius"}) {
+        for (const char* key : {attr::g.name, attr::radius.name}) {
             if (const double v = check.number(key); !(v > 0)) {
                 check.fail(fmt::format("attribute {} = {} is out of range: accepted > 0", key, v));
             }
@@ -718,7 +719,7 @@ void ResultReader::validate_tiles()
 {
     const Checker check(file_, path_);
     ResultInfo& in = info_;
-    in.tile_shape = check.integers("tile_shape", in.shape.size());
+    in.tile_shape = check.integers(attr::tile_shape, in.shape.size());
     for (std::size_t k = 0; k < in.shape.size(); ++k) {
         if (in.tile_shape[k] < 1 || in.tile_shape[k] > in.shape[k]) {
             check.fail(fmt::format("attribute tile_shape = ({}) does not fit the data ({})", fmt::join(in.tile_shape, ", "),
