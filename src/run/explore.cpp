@@ -700,47 +700,142 @@ std::string join_notes(const std::string& a, const std::string& b)
     return a.empty() ? b : b.empty() ? a : a + "; " + b;
 }
 
+// A run of run_explore once its partial file is made or read, on every rank: what it
+// counts, the file, and rank 0's record of it.
+struct OpenRun {
+    OpenRun(const mpi::Comm& comm, const Job& job, const ExplorePlan& plan, const Provenance& provenance,
+            std::chrono::steady_clock::time_point started)
+        : comm(comm),
+          job(job),
+          plan(plan),
+          provenance(provenance),
+          started(started),
+          partial(layout::partial_path(plan.output)),
+          grid(job),
+          start(start_everywhere(comm, partial, plan.mode, job, grid, provenance)),
+          tiling(grid.shape(), start.tile_shape),
+          file(partial, comm, tiling, start.layout)
+    {
+    }
+    const mpi::Comm& comm;
+    const Job& job;
+    const ExplorePlan& plan;
+    const Provenance& provenance;
+    const std::chrono::steady_clock::time_point started;
+    const fs::path partial;
+    const Grid grid;
+    StartedPartial start;  // its done flags go to the recorder
+    const Tiling tiling;
+    PartialFile file;
+    std::optional<Recorder> recorder;  // rank 0's
+};
+
 // What rank 0 does with the partial file once the tiles are counted: an interrupted run's
 // seconds recorded in it, a complete run's result made from it. A failure on rank 0 is
 // thrown on every rank.
-FinishReport close_run(const mpi::Comm& comm, PartialFile& file, std::optional<Recorder>& recorder, bool interrupted,
-                       const fs::path& partial, const Job& job, const Grid& grid, const Tiling& tiling,
-                       const PartialLayout& layout, const Provenance& provenance, const ExplorePlan& plan,
-                       double seconds_before, std::chrono::steady_clock::time_point started, RunObserver& observer)
+FinishReport close_run(OpenRun& run, bool interrupted, RunObserver& observer)
 {
+    const mpi::Comm& comm = run.comm;
     FinishReport finish;
     std::optional<Failure> failure;
     if (comm.is_root()) {
         failure = attempt([&] {
             if (interrupted) {
-                recorder->checkpoint();
+                run.recorder->checkpoint();
             } else {
-                recorder->last();
+                run.recorder->last();
             }
         });
     }
     // The run's figures, in the partial file (a stop) or the result (complete), by rank 0
     // alone once every rank has closed the file.
-    file.close();
+    run.file.close();
     comm.barrier();
     if (comm.is_root() && !failure) {
         failure = attempt([&] {
-            const double seconds = seconds_since(started);
+            const double seconds = seconds_since(run.started);
             if (interrupted) {
-                record_partial_run(partial, seconds, provenance);
+                record_partial_run(run.partial, seconds, run.provenance);
             } else {
                 observer.finishing();
-                finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout,
-                                       recorder->journal().done(), {provenance, seconds_before + seconds, true});
+                finish = finish_result(run.partial, run.plan.output, result_info(run.job, run.grid), run.tiling,
+                                       run.start.layout, run.recorder->journal().done(),
+                                       {run.provenance, run.start.earlier_seconds + seconds, true});
             }
         });
         if (failure) {
             failure->message = fmt::format("{} {} failed: {}", interrupted ? "recording the run in" : "finishing the result from",
-                                           partial.string(), failure->message);
+                                           run.partial.string(), failure->message);
         }
     }
     throw_everywhere(comm, failure);
     return finish;
+}
+
+// The tiles of a run counted: how the schedule went, the tallies of this rank's points,
+// when counting ended.
+struct Counted {
+    ScheduleResult schedule;
+    std::vector<std::uint64_t> tallies;  // ExploreWork::tallies
+    double compute_seconds = 0;          // the same on every rank
+    std::chrono::steady_clock::time_point end;
+};
+
+// Collective: the tiles `left` counted by the ranks under the schedule, rank 0 recording
+// them (run.recorder, made here).
+Counted count_run(OpenRun& run, TilesLeft left, const ExploreSettings& settings, RunObserver& observer,
+                  const StopRequested& stop)
+{
+    const mpi::Comm& comm = run.comm;
+    const Job& job = run.job;
+    const PartialLayout& layout = run.start.layout;
+    ScheduleSettings schedule;
+    schedule.node_ranks = settings.node_ranks;
+    schedule.writers = static_cast<int>(settings.writers.value_or(job.writers));
+    const int writers = layout.compressed ? schedule_writers(comm, schedule) : 1;
+    if (comm.is_root()) {
+        observer.started({run.plan.output, join_notes(run.plan.note, writers_note(schedule.writers, writers, layout)),
+                          comm.size(), job.points(), run.tiling.tiles(), run.tiling.box(0).points(), left.done,
+                          left.points_done});
+        run.recorder.emplace(run.file, run.partial, std::move(run.start.done), job, layout, run.tiling, observer, writers);
+    }
+    // Several writers: rank 0 records where the others wrote and grants them file space;
+    // each rank but 0 holds a sink, used if the schedule makes it a writer.
+    std::optional<AppenderSink> sink;
+    Writers writing;
+    if (writers > 1 && comm.is_root()) {
+        writing.placed = [&](std::span<const AppendedTile> tiles) { run.recorder->placed(tiles); };
+        writing.grant = [&](std::uint64_t bytes) { return run.recorder->grant(bytes); };
+    } else if (writers > 1) {
+        writing.sink = &sink.emplace(run.file, job);
+    }
+
+    // Uncompressed tiles: each rank writes its own, in pieces of at least one alignment
+    // unit (and 4 MiB of counts), and blocks of tiles are multiples of one where they can
+    // be, so that ranks rarely share a stripe. Not larger: a rank waits at the end of its
+    // run for its last buffer to reach the file system, and with 8 MiB that wait cost a
+    // quarter of `explore -n 2`'s speed on the 4096^2 slice (1.54e8 against 2.03e8
+    // points/s, medians of 5 interleaved runs); 2 MiB was no faster and made more than 3
+    // write calls per million points at 8192^2.
+    std::optional<TileWriter> writer;
+    if (!layout.compressed) writer.emplace(run.file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
+    Work work(job, run.grid, run.tiling, layout, writer ? &*writer : nullptr, settings.kernel);
+    const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
+        run.recorder->done(tiles, payload);
+    };
+    // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
+    // and the granule only groups tiles for the interleaved hand-out.
+    schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    // Every rank holds the hand-out list through the run (4 bytes a tile): made in place
+    // from what is left, not beside it.
+    const std::vector<ListedTile> pending =
+        handout_order(std::move(left.pending), schedule.granule, comm.size() >= settings.interleave_ranks);
+    const auto compute_start = std::chrono::steady_clock::now();
+    Counted c{run_schedule(comm, pending, work, on_done, stop, schedule, writing), work.tallies(), 0,
+              std::chrono::steady_clock::now()};
+    c.compute_seconds = comm.broadcast(std::chrono::duration<double>(c.end - compute_start).count());
+    if (comm.is_root()) observer.computed(c.compute_seconds);
+    return c;
 }
 
 // Collective: every rank's ScheduleStats reduced to the run's figures (rank 0's own where
@@ -806,10 +901,9 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const auto started = std::chrono::steady_clock::now();
     const ExplorePlan plan = plan_explore(job, settings, comm);
     const Provenance provenance = run_provenance(settings, comm.size(), mpi::host_count(comm), 1);
-    const fs::path partial = layout::partial_path(plan.output);
     RunSummary summary;
     summary.output = plan.output;
-    summary.partial = partial;
+    summary.partial = layout::partial_path(plan.output);
     summary.ranks = comm.size();
     summary.outcomes.assign(outcome_count, 0);
     if (plan.mode == PlanMode::complete) {
@@ -819,84 +913,31 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     }
 
     // The partial file and its journal: made by rank 0 (a new run) or read (a resume).
-    const Grid grid(job);
-    StartedPartial start = start_everywhere(comm, partial, plan.mode, job, grid, provenance);
-    const PartialLayout& layout = start.layout;
-    const Tiling tiling(grid.shape(), start.tile_shape);
-    PartialFile file(partial, comm, tiling, layout);
-    TilesLeft left = tiles_left(comm, file, partial, plan.mode, start.done, tiling);
-    ScheduleSettings schedule;
-    schedule.node_ranks = settings.node_ranks;
-    schedule.writers = static_cast<int>(settings.writers.value_or(job.writers));
-    const int writers = layout.compressed ? schedule_writers(comm, schedule) : 1;
-    std::optional<Recorder> recorder;
-    if (comm.is_root()) {
-        const RunStart run_start{plan.output, join_notes(plan.note, writers_note(schedule.writers, writers, layout)),
-                                 comm.size(), job.points(), tiling.tiles(), tiling.box(0).points(), left.done,
-                                 left.points_done};
-        observer.started(run_start);
-        recorder.emplace(file, partial, std::move(start.done), job, layout, tiling, observer, writers);
-    }
-    // Several writers: rank 0 records where the others wrote and grants them file space;
-    // each rank but 0 holds a sink, used if the schedule makes it a writer.
-    std::optional<AppenderSink> sink;
-    Writers writing;
-    if (writers > 1 && comm.is_root()) {
-        writing.placed = [&](std::span<const AppendedTile> tiles) { recorder->placed(tiles); };
-        writing.grant = [&](std::uint64_t bytes) { return recorder->grant(bytes); };
-    } else if (writers > 1) {
-        writing.sink = &sink.emplace(file, job);
-    }
-
-    // Uncompressed tiles: each rank writes its own, in pieces of at least one alignment
-    // unit (and 4 MiB of counts), and blocks of tiles are multiples of one where they can
-    // be, so that ranks rarely share a stripe. Not larger: a rank waits at the end of its
-    // run for its last buffer to reach the file system, and with 8 MiB that wait cost a
-    // quarter of `explore -n 2`'s speed on the 4096^2 slice (1.54e8 against 2.03e8
-    // points/s, medians of 5 interleaved runs); 2 MiB was no faster and made more than 3
-    // write calls per million points at 8192^2.
-    std::optional<TileWriter> writer;
-    if (!layout.compressed) writer.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
-    Work work(job, grid, tiling, layout, writer ? &*writer : nullptr, settings.kernel);
-    const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
-        recorder->done(tiles, payload);
-    };
-    // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
-    // and the granule only groups tiles for the interleaved hand-out.
-    schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
-    // Every rank holds the hand-out list through the run (4 bytes a tile): made in place
-    // from what is left, not beside it.
-    const std::vector<ListedTile> pending =
-        handout_order(std::move(left.pending), schedule.granule, comm.size() >= settings.interleave_ranks);
-    left = {};
-    const auto compute_start = std::chrono::steady_clock::now();
-    const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule, writing);
-    const auto compute_end = std::chrono::steady_clock::now();
-    const double compute_seconds = comm.broadcast(std::chrono::duration<double>(compute_end - compute_start).count());
-    if (comm.is_root()) observer.computed(compute_seconds);
-
-    const FinishReport finish = close_run(comm, file, recorder, r.interrupted, partial, job, grid, tiling, layout,
-                                          provenance, plan, start.earlier_seconds, started, observer);
-    if (!r.interrupted) {
+    OpenRun run(comm, job, plan, provenance, started);
+    Counted counted = count_run(run, tiles_left(comm, run.file, run.partial, plan.mode, run.start.done, run.tiling), settings,
+                                observer, stop);
+    const bool interrupted = counted.schedule.interrupted;
+    const FinishReport finish = close_run(run, interrupted, observer);
+    if (!interrupted) {
         // From the last tile counted to the result under its name.
-        summary.finish_seconds = comm.broadcast(comm.is_root() ? seconds_since(compute_end) : 0.0);
+        summary.finish_seconds = comm.broadcast(comm.is_root() ? seconds_since(counted.end) : 0.0);
         summary.raw_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(finish.raw_bytes)));
         summary.result_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(finish.file_bytes)));
         summary.sidecar_note = finish.sidecar_note;
         comm.broadcast(summary.sidecar_note);
     }
 
-    std::vector<std::uint64_t> totals = comm.sum(work.tallies());  // with the histogram: one reduction
+    std::vector<std::uint64_t> totals = comm.sum(counted.tallies);  // with the histogram: one reduction
     summary.points_this_run = totals.back();
     totals.pop_back();
     summary.points_counted = totals.back();
     totals.pop_back();
     summary.outcomes = std::move(totals);
-    summary.compute_seconds = compute_seconds;
+    summary.compute_seconds = counted.compute_seconds;
     summary.peak_rss_mib = comm.max(peak_rss_mib());
-    summary.schedule = schedule_figures(comm, r.stats);
-    summary.interrupted = r.interrupted;
-    summary.complete = !r.interrupted;
+    summary.schedule = schedule_figures(comm, counted.schedule.stats);
+    summary.interrupted = interrupted;
+    summary.complete = !interrupted;
     return summary;
 }
 
