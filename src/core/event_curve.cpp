@@ -47,12 +47,26 @@ Eigen::Vector2d fold_side(const std::vector<BranchPoint>& points, std::size_t i,
     return points[j].parameter > points[i].parameter ? along : Eigen::Vector2d(-along);
 }
 
-// The event of kind `event` on the line through (q1, q2) along (n1, n2) nearest to it,
-// following the cycle through the predicted state from s = s0 on the line.
-std::optional<Found> locate_on_line(const Plane& plane, Event event, int period, Domain domain,
-                                    const CanonicalState<double>& predicted, double q1, double q2, double n1, double n2,
-                                    double s0, double half_width)
+// What is traced: an event of a cycle of some period, in a domain of the map.
+struct Sought {
+    Event event;
+    int period;
+    Domain domain;
+};
+
+// A line of the plane: the points q + s n.
+struct PlaneLine {
+    double q1, q2;  // its origin
+    double n1, n2;  // a unit vector along it
+};
+
+// The event sought on `on` nearest to its origin, following the cycle through the
+// predicted state from s = s0 on the line, within half_width of the origin.
+std::optional<Found> locate_on_line(const Plane& plane, const Sought& sought, const CanonicalState<double>& predicted,
+                                    const PlaneLine& on, double s0, double half_width)
 {
+    const auto [event, period, domain] = sought;
+    const auto [q1, q2, n1, n2] = on;
     const ParameterPath path = line(plane, q1, q2, n1, n2);
     const ModelMatrices m = ModelMatrices::of(path.at(s0));
     const auto point = newton_cycle(predicted, m, period, domain);
@@ -88,9 +102,9 @@ bool inside(const EventCurveSettings& set, double a, double b)
     return a >= set.min1 && a <= set.max1 && b >= set.min2 && b <= set.max2;
 }
 
-Direction trace(const Plane& plane, const Found& start, double sign, Event event, int period, Domain domain,
-                const EventCurveSettings& set)
+Direction trace(const Plane& plane, const Found& start, double sign, const Sought& sought, const EventCurveSettings& set)
 {
+    const Event event = sought.event;
     Direction d;
     Found last = start;
     double h = set.initial_step;
@@ -116,8 +130,7 @@ Direction trace(const Plane& plane, const Found& start, double sign, Event event
         std::optional<Found> found;
         for (const double s0 : {0.0, 0.5, 1.0, 2.0}) {
             if (s0 > 0.0 && event != Event::fold) break;
-            found = locate_on_line(plane, event, period, domain, as_state(x), q1, q2, n(0), n(1), s0 * h,
-                                   line_half_width * h);
+            found = locate_on_line(plane, sought, as_state(x), {q1, q2, n(0), n(1)}, s0 * h, line_half_width * h);
             if (found) break;
         }
         if (!found || !inside(set, found->first, found->second)) {
@@ -173,8 +186,9 @@ std::optional<EventCurve> continue_event(const Branch& branch, std::size_t index
     const Plane plane{with_parameter(model, first, e.parameter), first, second};
     Found start{e.parameter, parameter_value(model, second), e, 0.0};
     if (e.event == Event::fold) start.side = fold_side(branch.points, index, Eigen::Vector2d(1.0, 0.0));
-    const Direction up = trace(plane, start, 1.0, e.event, branch.period, branch.domain, settings);
-    const Direction down = trace(plane, start, -1.0, e.event, branch.period, branch.domain, settings);
+    const Sought sought{e.event, branch.period, branch.domain};
+    const Direction up = trace(plane, start, 1.0, sought, settings);
+    const Direction down = trace(plane, start, -1.0, sought, settings);
     if (up.points.empty() && down.points.empty()) return std::nullopt;
     EventCurve c;
     c.event = e.event;
