@@ -246,6 +246,14 @@ StartedPartial start_partial(const fs::path& partial, PlanMode mode, const Job& 
     return p;
 }
 
+InputError damaged_partial(const fs::path& partial, std::span<const std::uint64_t> bad, std::uint64_t done)
+{
+    return InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
+                                  "written with them; refusing to resume onto it: --overwrite to start again, or --output "
+                                  "to write elsewhere",
+                                  partial.string(), bad.size(), done, bad.front()));
+}
+
 double peak_rss_mib()
 {
     rusage u{};
@@ -673,10 +681,7 @@ TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& p
     }
     if (const std::vector<std::uint64_t> bad = file.damaged(mine, record.checksums, record.stored); !bad.empty()) {
         file.close();
-        throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the "
-                                     "checksum written with them; refusing to resume onto it: --overwrite to start "
-                                     "again, or --output to write elsewhere",
-                                     partial.string(), bad.size(), left.done, bad.front()));
+        throw damaged_partial(partial, bad, left.done);
     }
     return left;
 }

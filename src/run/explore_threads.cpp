@@ -99,10 +99,7 @@ std::pair<std::vector<std::uint64_t>, std::vector<std::uint64_t>> tiles_left(Par
     const JournalRecord record = read_journal(file, done_tiles);
     if (const std::vector<std::uint64_t> bad = file.damaged(done_tiles, record.checksums, record.stored); !bad.empty()) {
         file.close();
-        throw InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
-                                     "written with them; refusing to resume onto it: overwrite to start again, or write "
-                                     "elsewhere",
-                                     partial.string(), bad.size(), done_tiles.size(), bad.front()));
+        throw damaged_partial(partial, bad, done_tiles.size());
     }
     return {std::move(done_tiles), std::move(pending)};
 }

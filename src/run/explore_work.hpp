@@ -91,6 +91,10 @@ private:
 // the reports that came with it (std::logic_error if they differ).
 TileBatch batch_of(std::span<const TileReport> tiles, std::span<const std::byte> payload);
 
+// The refusal to resume onto a partial file whose done tiles `bad` (of `done`) no longer
+// match the checksums written with them: the same words from both drivers.
+InputError damaged_partial(const std::filesystem::path& partial, std::span<const std::uint64_t> bad, std::uint64_t done);
+
 // Peak resident memory of this process, in MiB (Linux reports ru_maxrss in KiB).
 double peak_rss_mib();
 

@@ -14,6 +14,7 @@
 #include "core/count.hpp"
 #include "core/kernels.hpp"
 #include "io/layout.hpp"
+#include "io/partial_file.hpp"
 #include "io/result_reader.hpp"
 #include "job/grid.hpp"
 #include "job/job.hpp"
@@ -109,6 +110,46 @@ TEST(RunExploreThreads, StoppedRunResumesToTheSameResult)
     EXPECT_NE(info.history.find('\n'), std::string::npos) << info.history;  // a line per run
     Tally nothing;
     EXPECT_TRUE(run_explore_threads(job, settings(out, true), 2, nothing, never).nothing_to_do);
+}
+
+// A done tile whose stored bytes changed since it was recorded: the resume is refused, in
+// the words run_explore uses, and the file is left as it was.
+TEST(RunExploreThreads, RefusesToResumeOntoADamagedTile)
+{
+    const TempDir dir{"superball-threads"};
+    const Job job = job_of("tile_points = 16\ncheckpoint_seconds = 0.01");
+    const fs::path out = dir / "damaged.h5";
+    std::atomic<int> polls{0};
+    Tally first;
+    ASSERT_TRUE(run_explore_threads(job, settings(out), 1, first, [&] { return ++polls > 20; }).interrupted);
+    const fs::path partial = layout::partial_path(out);
+    std::uint64_t address = 0, tile = 0;
+    {
+        const ResultReader reader(partial);
+        const std::vector<std::uint8_t> done = reader.tiles_done();
+        while (done.at(tile) == 0) ++tile;
+        const Tiling tiling(reader.info().shape, reader.info().tile_shape);
+        PartialFile file(partial, tiling, partial_layout(partial, tiling));
+        address = read_journal(file, std::vector<std::uint64_t>{tile}).stored.at(0).address;
+    }
+    {
+        std::fstream f(partial, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekg(static_cast<std::streamoff>(address));
+        const char byte = static_cast<char>(f.get() ^ 0x5a);
+        f.seekp(static_cast<std::streamoff>(address));
+        f.put(byte);
+    }
+    const auto bytes_before = fs::file_size(partial);
+    Tally second;
+    try {
+        run_explore_threads(job, settings(out, true), 2, second, never);
+        FAIL() << "resumed onto a damaged tile";
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("(first: tile " + std::to_string(tile) + ")"), std::string::npos) << m;
+        EXPECT_NE(m.find("--overwrite to start again, or --output to write elsewhere"), std::string::npos) << m;
+    }
+    EXPECT_EQ(fs::file_size(partial), bytes_before);
 }
 
 TEST(RunExploreThreads, RefusesOutputsAsTheCommandLineDoes)
