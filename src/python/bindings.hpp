@@ -14,14 +14,34 @@ namespace superball {
 // Keys as the Python API spells them: its argument names.
 inline std::string python_key(std::string_view key) { return std::string(key); }
 
-inline ModelInput model_input(std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall,
-                              std::optional<double> alpha_wall, std::optional<double> e_floor,
-                              std::optional<double> alpha_floor)
-{
-    return {e, alpha, e_wall, alpha_wall, e_floor, alpha_floor};
-}
-
 // fixed_points() and continue_branch() (dynamics.cpp).
 void add_dynamics(pybind11::module_& m);
 
 }  // namespace superball
+
+// The model's coefficients as the package passes them to _core: one dict (`model=`, made by
+// superball._model) of e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, each a float or
+// None (not given), rather than six arguments of every function.
+namespace pybind11::detail {
+template <>
+struct type_caster<superball::ModelInput> {
+    PYBIND11_TYPE_CASTER(superball::ModelInput, const_name("dict[str, float | None]"));
+    bool load(handle src, bool)
+    {
+        if (!isinstance<dict>(src)) return false;
+        const auto given = reinterpret_borrow<dict>(src);
+        const std::pair<const char*, std::optional<double> superball::ModelInput::*> keys[] = {
+            {"e", &superball::ModelInput::e},           {"alpha", &superball::ModelInput::alpha},
+            {"e_wall", &superball::ModelInput::e_wall}, {"alpha_wall", &superball::ModelInput::alpha_wall},
+            {"e_floor", &superball::ModelInput::e_floor}, {"alpha_floor", &superball::ModelInput::alpha_floor}};
+        std::size_t known = 0;
+        for (const auto& [key, member] : keys) {
+            if (!given.contains(key)) continue;
+            ++known;
+            const object v = given[key];
+            if (!v.is_none()) value.*member = v.cast<double>();
+        }
+        return known == given.size();  // no other key
+    }
+};
+}  // namespace pybind11::detail

@@ -43,11 +43,9 @@ py::dict cycle_dict(const Cycle& c)
 }
 
 // fixed_points(): every distinct cycle, as fixed-points prints it.
-py::list fixed_point_list(std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall,
-                          std::optional<double> alpha_wall, std::optional<double> e_floor, std::optional<double> alpha_floor,
-                          int period, std::int64_t starts, std::uint64_t seed, bool corner)
+py::list fixed_point_list(const ModelInput& given, int period, std::int64_t starts, std::uint64_t seed, bool corner)
 {
-    const Model model = resolve_model(model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor), python_key);
+    const Model model = resolve_model(given, python_key);
     const CycleSearch search{period, starts, seed, corner};
     check_cycle_search(search, python_key);
     std::vector<Cycle> cycles;
@@ -124,18 +122,17 @@ py::dict continuation(const ContinuationInput& in)
 
 void add_dynamics(py::module_& m)
 {
-    m.def("fixed_points", &fixed_point_list, py::arg("e"), py::arg("alpha"), py::arg("e_wall"), py::arg("alpha_wall"),
-          py::arg("e_floor"), py::arg("alpha_floor"), py::arg("period"), py::arg("starts"), py::arg("seed"), py::arg("corner"));
+    m.def("fixed_points", &fixed_point_list, py::arg("model"), py::arg("period"), py::arg("starts"), py::arg("seed"),
+          py::arg("corner"));
     m.def(
         "continue_branch",
-        [](std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall, std::optional<double> alpha_wall,
-           std::optional<double> e_floor, std::optional<double> alpha_floor, const std::string& param, std::optional<double> min,
+        [](const ModelInput& model, const std::string& param, std::optional<double> min,
            std::optional<double> max, std::optional<std::array<double, 3>> start, int period, std::int64_t starts,
            std::uint64_t seed, bool corner, std::optional<double> step, double max_step, double min_step, int max_points,
            const std::string& curve, std::optional<double> curve_min, std::optional<double> curve_max, double curve_step,
            double curve_max_step, int curve_max_points) {
             ContinuationInput in;
-            in.model = model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor);
+            in.model = model;
             in.param = param;
             in.min = min;
             in.max = max;
@@ -156,8 +153,7 @@ void add_dynamics(py::module_& m)
             in.curve_max_points = curve_max_points;
             return continuation(in);
         },
-        py::arg("e"), py::arg("alpha"), py::arg("e_wall"), py::arg("alpha_wall"), py::arg("e_floor"), py::arg("alpha_floor"),
-        py::arg("param"), py::arg("min"), py::arg("max"), py::arg("start"), py::arg("period"), py::arg("starts"),
+        py::arg("model"), py::arg("param"), py::arg("min"), py::arg("max"), py::arg("start"), py::arg("period"), py::arg("starts"),
         py::arg("seed"), py::arg("corner"), py::arg("step"), py::arg("max_step"), py::arg("min_step"), py::arg("max_points"),
         py::arg("curve"), py::arg("curve_min"), py::arg("curve_max"), py::arg("curve_step"), py::arg("curve_max_step"),
         py::arg("curve_max_points"));

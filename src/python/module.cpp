@@ -209,11 +209,10 @@ py::tuple one_start(const std::vector<std::string>& given, std::optional<double>
 // shape (NumPy views) and checked the scalars' types. Returns (wall_bounces uint32,
 // outcome uint8) of that shape.
 py::tuple count_arrays(const std::vector<std::pair<std::string, py::array>>& coordinates, bool physical, double g,
-                       double radius, std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall,
-                       std::optional<double> alpha_wall, std::optional<double> e_floor, std::optional<double> alpha_floor,
-                       std::uint32_t max_bounces, unsigned threads, const std::string& kernel)
+                       double radius, const ModelInput& given, std::uint32_t max_bounces, unsigned threads,
+                       const std::string& kernel)
 {
-    const Model model = resolve_model(model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor), python_key);
+    const Model model = resolve_model(given, python_key);
     const CountKernel k = kernel_of(kernel).count;
     std::vector<CoordinateArray> c;
     for (const auto& [name, a] : coordinates) c.emplace_back(name, a);
@@ -261,11 +260,9 @@ py::array_t<T> column(const std::vector<TrajectoryRow>& rows, T TrajectoryRow::*
 }
 
 // trajectory(): (columns as the CLI's CSV, what the launch came to).
-py::tuple trajectory_table(const StartInput& in, std::optional<double> e, std::optional<double> alpha,
-                           std::optional<double> e_wall, std::optional<double> alpha_wall, std::optional<double> e_floor,
-                           std::optional<double> alpha_floor, std::uint32_t max_bounces, int samples)
+py::tuple trajectory_table(const StartInput& in, const ModelInput& given, std::uint32_t max_bounces, int samples)
 {
-    const Model model = resolve_model(model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor), python_key);
+    const Model model = resolve_model(given, python_key);
     const Start start = resolve_start(in, python_key);
     if (samples != 0 && (samples < 2 || samples > 100000)) {
         throw InputError("samples = " + std::to_string(samples) + " is out of range: accepted 0 or 2..100000");
@@ -308,17 +305,19 @@ py::dict job_dict(const Job& job)
 
 // explore(): runs the job on threads (GIL released); Ctrl-C stops it cleanly (the partial
 // file is kept, resumable) and raises KeyboardInterrupt.
-py::dict explore(const std::string& text, const std::string& source, const std::string& output, bool overwrite, bool resume,
-                 unsigned threads, const std::string& kernel, const std::string& command, bool progress)
+// `run`: as the package passes it, output, overwrite, resume, threads, kernel, command and
+// progress.
+py::dict explore(const std::string& text, const std::string& source, const py::dict& run)
 {
     const Job job = parse_job(text, source);
     ExploreSettings settings;
-    settings.output = output;
-    settings.overwrite = overwrite;
-    settings.resume = resume;
-    settings.kernel = kernel_of(kernel).count;
-    settings.command = command;
-    TerminalProgress observer(stderr, !progress);
+    settings.output = run["output"].cast<std::string>();
+    settings.overwrite = run["overwrite"].cast<bool>();
+    settings.resume = run["resume"].cast<bool>();
+    settings.kernel = kernel_of(run["kernel"].cast<std::string>()).count;
+    settings.command = run["command"].cast<std::string>();
+    const auto threads = run["threads"].cast<unsigned>();
+    TerminalProgress observer(stderr, !run["progress"].cast<bool>());
     std::optional<py::error_already_set> interrupt;
     // Polled on this (the calling) thread between its tiles: Python runs signal handlers on
     // its main thread only, and only when asked.
@@ -419,34 +418,25 @@ PYBIND11_MODULE(_core, m)
     m.def(
         "resolve_one_start",
         [](const std::vector<std::string>& given, std::optional<double> g, std::optional<double> radius,
-           const std::string& max_bounces, std::optional<double> e, std::optional<double> alpha,
-           std::optional<double> e_wall, std::optional<double> alpha_wall, std::optional<double> e_floor,
-           std::optional<double> alpha_floor) {
-            return one_start(given, g, radius, max_bounces, model_input(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor));
+           const std::string& max_bounces, const ModelInput& model) {
+            return one_start(given, g, radius, max_bounces, model);
         },
-        py::arg("given"), py::arg("g"), py::arg("radius"), py::arg("max_bounces"), py::arg("e"), py::arg("alpha"),
-        py::arg("e_wall"), py::arg("alpha_wall"), py::arg("e_floor"), py::arg("alpha_floor"));
-    m.def("count", &count_arrays, py::arg("coordinates"), py::arg("physical"), py::arg("g"), py::arg("radius"), py::arg("e"),
-          py::arg("alpha"), py::arg("e_wall"), py::arg("alpha_wall"), py::arg("e_floor"), py::arg("alpha_floor"),
-          py::arg("max_bounces"), py::arg("threads"), py::arg("kernel"));
+        py::arg("given"), py::arg("g"), py::arg("radius"), py::arg("max_bounces"), py::arg("model"));
+    m.def("count", &count_arrays, py::arg("coordinates"), py::arg("physical"), py::arg("g"), py::arg("radius"),
+          py::arg("model"), py::arg("max_bounces"), py::arg("threads"), py::arg("kernel"));
     m.def(
         "trajectory",
         [](std::optional<double> xi, std::optional<double> U, std::optional<double> W, std::optional<double> x,
            std::optional<double> u, std::optional<double> v, std::optional<double> omega, std::optional<double> g,
-           std::optional<double> radius, std::optional<double> e, std::optional<double> alpha, std::optional<double> e_wall,
-           std::optional<double> alpha_wall, std::optional<double> e_floor, std::optional<double> alpha_floor,
-           std::uint32_t max_bounces, int samples) {
-            return trajectory_table({xi, U, W, x, u, v, omega, g, radius}, e, alpha, e_wall, alpha_wall, e_floor, alpha_floor,
-                                    max_bounces, samples);
+           std::optional<double> radius, const ModelInput& model, std::uint32_t max_bounces, int samples) {
+            return trajectory_table({xi, U, W, x, u, v, omega, g, radius}, model, max_bounces, samples);
         },
         py::arg("xi"), py::arg("U"), py::arg("W"), py::arg("x"), py::arg("u"), py::arg("v"), py::arg("omega"), py::arg("g"),
-        py::arg("radius"), py::arg("e"), py::arg("alpha"), py::arg("e_wall"), py::arg("alpha_wall"), py::arg("e_floor"),
-        py::arg("alpha_floor"), py::arg("max_bounces"), py::arg("samples"));
+        py::arg("radius"), py::arg("model"), py::arg("max_bounces"), py::arg("samples"));
     add_dynamics(m);
     m.def("parse_job", [](const std::string& text, const std::string& source) { return job_dict(parse_job(text, source)); },
           py::arg("text"), py::arg("source"));
     m.def("load_job", [](const std::string& path) { return job_dict(load_job(path)); }, py::arg("path"));
-    m.def("explore", &explore, py::arg("text"), py::arg("source"), py::arg("output"), py::arg("overwrite"), py::arg("resume"),
-          py::arg("threads"), py::arg("kernel"), py::arg("command"), py::arg("progress"));
+    m.def("explore", &explore, py::arg("text"), py::arg("source"), py::arg("run"));
     m.def("validate", &validate, py::arg("path"));
 }

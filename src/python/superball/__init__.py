@@ -160,7 +160,7 @@ def _one_start(coordinates, g, radius, model, max_bounces):
     library's checks of count and trajectory, in the command line's order and words."""
     given = [name for name, value in coordinates.items() if value is not None]
     physical, g, radius, max_bounces = _core.resolve_one_start(given, _real("g", g), _real("radius", radius),
-                                                              str(_integral("max_bounces", max_bounces)), **model)
+                                                              str(_integral("max_bounces", max_bounces)), model=model)
     names = ("x", "u", "v", "omega") if physical else ("xi", "U", "W")
     return physical, {name: coordinates[name] for name in names}, g, radius, max_bounces
 
@@ -230,7 +230,7 @@ def count(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None
         raise ValueError(f"the coordinates' shapes do not broadcast together: {given}") from None
     coordinates = [(name, np.broadcast_to(a, shape)) for name, a in arrays.items()]
     wall_bounces, outcome = _core.count(coordinates, physical, g, radius, max_bounces=max_bounces, threads=threads,
-                                        kernel=kernel, **model)
+                                        kernel=kernel, model=model)
     if shape == ():
         return Counts(int(wall_bounces), Outcome(int(outcome)))
     return Counts(wall_bounces, outcome)
@@ -265,7 +265,7 @@ def trajectory(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g
     coordinates = dict(xi=None, U=None, W=None, x=None, u=None, v=None, omega=None)
     coordinates.update(values)
     columns, result = _core.trajectory(**coordinates, g=_real("g", g), radius=_real("radius", radius),
-                                       max_bounces=max_bounces, samples=samples, **model)
+                                       max_bounces=max_bounces, samples=samples, model=model)
     out = Trajectory(columns)
     out["event"] = np.asarray(columns["event"], dtype=str)
     out.wall_bounces = result["wall_bounces"]
@@ -301,7 +301,7 @@ def fixed_points(*, e=None, alpha=None, e_wall=None, alpha_wall=None, e_floor=No
     period = _integer("period", period, -2**31, 2**31 - 1, "1 to 8")
     starts = _integer("starts", starts, -2**63, 2**63 - 1, "starts >= 1")
     seed = _integer("seed", seed, 0, 2**64 - 1, "0 to 2^64 - 1")
-    cycles = _core.fixed_points(period=period, starts=starts, seed=seed, corner=bool(corner), **model)
+    cycles = _core.fixed_points(period=period, starts=starts, seed=seed, corner=bool(corner), model=model)
     out = {}
     for key in _CYCLE_COLUMNS:
         if key.startswith("eig"):
@@ -384,7 +384,7 @@ def continue_branch(*, param, min, max, e=None, alpha=None, e_wall=None, alpha_w
         curve_step=_real("curve_step", curve_step, optional=False),
         curve_max_step=_real("curve_max_step", curve_max_step, optional=False),
         curve_max_points=_integer("curve_max_points", curve_max_points, -2**31, 2**31 - 1, "curve_max_points >= 1"),
-        **model)
+        model=model)
     p = r["parameter"]
     rows = []
     for i, b in enumerate(r["branches"]):
@@ -490,12 +490,12 @@ def explore(job, output=None, *, overwrite=False, resume=False, threads=None, ke
         raise TypeError(f"job must be a job file's path or a dict of its tables, not {type(job).__name__}")
     if output is not None and not isinstance(output, (str, os.PathLike)):
         raise TypeError(f"output must be a file path or None, not {type(output).__name__}")
-    run = dict(text=parsed["text"], source=source, overwrite=bool(overwrite), resume=bool(resume),
-               threads=_threads(threads), kernel=_kernel(kernel), command=command, progress=bool(progress))
+    run = dict(overwrite=bool(overwrite), resume=bool(resume), threads=_threads(threads), kernel=_kernel(kernel),
+               command=command, progress=bool(progress))
     path = os.fspath(output) if output is not None else parsed["output"]
     if path:
         try:
-            summary = _core.explore(output=path, **run)
+            summary = _core.explore(parsed["text"], source, dict(run, output=path))
         except KeyboardInterrupt:
             import sys
 
@@ -504,7 +504,7 @@ def explore(job, output=None, *, overwrite=False, resume=False, threads=None, ke
             raise
         return open(summary["output"]) if dataset else summary
     with tempfile.TemporaryDirectory(prefix="superball-") as directory:
-        summary = _core.explore(output=os.path.join(directory, "result.h5"), **run)
+        summary = _core.explore(parsed["text"], source, dict(run, output=os.path.join(directory, "result.h5")))
         if not dataset:
             return summary
         with open(summary["output"]) as ds:
