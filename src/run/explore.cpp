@@ -246,6 +246,39 @@ StartedPartial start_partial(const fs::path& partial, PlanMode mode, const Job& 
     return p;
 }
 
+RunSummary first_summary(const ExplorePlan& plan, int ranks)
+{
+    RunSummary summary;
+    summary.output = plan.output;
+    summary.partial = layout::partial_path(plan.output);
+    summary.ranks = ranks;
+    summary.outcomes.assign(outcome_count, 0);
+    return summary;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+FinishReport record_or_finish(const ClosingRun& run, std::span<const std::uint8_t> done, bool interrupted,
+                              RunObserver& observer)
+{
+    try {
+        const double seconds = seconds_since(run.started);
+        if (interrupted) {
+            record_partial_run(run.partial, seconds, run.provenance);
+            return {};
+        }
+        observer.finishing();
+        return finish_result(run.partial, run.output, result_info(run.job, run.grid), run.tiling, run.layout, done,
+                             {run.provenance, run.earlier_seconds + seconds, true});
+    } catch (const std::exception& e) {
+        throw RunError(fmt::format("{} {} failed: {}", interrupted ? "recording the run in" : "finishing the result from",
+                                   run.partial.string(), e.what()));
+    }
+}
+
 InputError damaged_partial(const fs::path& partial, std::span<const std::uint64_t> bad, std::uint64_t done)
 {
     return InputError(fmt::format("{} is damaged: {} of its {} done tiles (first: tile {}) no longer match the checksum "
@@ -388,10 +421,6 @@ private:
     std::vector<std::uint8_t> outcomes_, chunk_outcomes_;
 };
 
-double seconds_since(std::chrono::steady_clock::time_point t)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 // Rank 0's append buffer, and a writer's: 8 MiB, or a stripe if larger.
 std::uint64_t append_buffer_bytes(const Job& job) { return std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment); }
@@ -758,20 +787,10 @@ FinishReport close_run(OpenRun& run, bool interrupted, RunObserver& observer)
     comm.barrier();
     if (comm.is_root() && !failure) {
         failure = attempt([&] {
-            const double seconds = seconds_since(run.started);
-            if (interrupted) {
-                record_partial_run(run.partial, seconds, run.provenance);
-            } else {
-                observer.finishing();
-                finish = finish_result(run.partial, run.plan.output, result_info(run.job, run.grid), run.tiling,
-                                       run.start.layout, run.recorder->journal().done(),
-                                       {run.provenance, run.start.earlier_seconds + seconds, true});
-            }
+            finish = record_or_finish({run.job, run.grid, run.tiling, run.start.layout, run.partial, run.plan.output,
+                                       run.provenance, run.start.earlier_seconds, run.started},
+                                      run.recorder->journal().done(), interrupted, observer);
         });
-        if (failure) {
-            failure->message = fmt::format("{} {} failed: {}", interrupted ? "recording the run in" : "finishing the result from",
-                                           run.partial.string(), failure->message);
-        }
     }
     throw_everywhere(comm, failure);
     return finish;
@@ -906,11 +925,7 @@ RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mp
     const auto started = std::chrono::steady_clock::now();
     const ExplorePlan plan = plan_explore(job, settings, comm);
     const Provenance provenance = run_provenance(settings, comm.size(), mpi::host_count(comm), 1);
-    RunSummary summary;
-    summary.output = plan.output;
-    summary.partial = layout::partial_path(plan.output);
-    summary.ranks = comm.size();
-    summary.outcomes.assign(outcome_count, 0);
+    RunSummary summary = first_summary(plan, comm.size());
     if (plan.mode == PlanMode::complete) {
         if (comm.is_root()) observer.started({plan.output, plan.note, comm.size(), job.points(), 0, 0, 0, 0});
         summary.complete = summary.nothing_to_do = true;

@@ -27,10 +27,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 // Counts `pending` on one thread per work: each takes the next `granule` tiles (an
 // alignment unit of an uncompressed file's tiles, so that a thread's writer joins them into
@@ -104,15 +100,36 @@ std::pair<std::vector<std::uint64_t>, std::vector<std::uint64_t>> tiles_left(Par
     return {std::move(done_tiles), std::move(pending)};
 }
 
-// The works' tallies (ExploreWork::tallies), summed.
-std::vector<std::uint64_t> tallies_of(std::span<const std::unique_ptr<ExploreWork>> works)
+// One work a thread, with its writer of uncompressed tiles (compressed ones go to the
+// recorder, as rank 0's do).
+struct ThreadWorks {
+    std::vector<std::optional<TileWriter>> writers;
+    std::vector<std::unique_ptr<ExploreWork>> works;
+};
+
+ThreadWorks make_works(unsigned threads, const Job& job, const Grid& grid, PartialFile& file, CountKernel kernel)
+{
+    ThreadWorks t;
+    t.writers.resize(threads);
+    const PartialLayout& layout = file.layout();
+    for (std::optional<TileWriter>& w : t.writers) {
+        if (!layout.compressed) w.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
+        t.works.push_back(make_explore_work(job, grid, file.tiling(), layout, w ? &*w : nullptr, kernel));
+    }
+    return t;
+}
+
+// The works' tallies (ExploreWork::tallies), summed, into the summary.
+void add_tallies(RunSummary& summary, std::span<const std::unique_ptr<ExploreWork>> works)
 {
     std::vector<std::uint64_t> totals(outcome_count + 2, 0);
     for (const auto& w : works) {
         const std::vector<std::uint64_t> t = w->tallies();
         for (std::size_t k = 0; k < totals.size(); ++k) totals[k] += t[k];
     }
-    return totals;
+    summary.points_this_run = totals[outcome_count + 1];
+    summary.points_counted = totals[outcome_count];
+    summary.outcomes.assign(totals.begin(), totals.begin() + outcome_count);
 }
 
 }  // namespace
@@ -125,10 +142,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     const ExplorePlan plan = plan_explore(job, settings);
     const Provenance provenance = run_provenance(settings, 1, 1, static_cast<int>(threads));
     const fs::path partial = layout::partial_path(plan.output);
-    RunSummary summary;
-    summary.output = plan.output;
-    summary.partial = partial;
-    summary.outcomes.assign(outcome_count, 0);
+    RunSummary summary = first_summary(plan, 1);
     if (plan.mode == PlanMode::complete) {
         observer.started({plan.output, plan.note, 1, job.points(), 0, 0, 0, 0});
         summary.complete = summary.nothing_to_do = true;
@@ -147,51 +161,33 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     for (const std::uint64_t t : done_tiles) start.points_done += tiling.box(t).points();
     observer.started(start);
 
-    // The writer side, as rank 0's: the journal, and one appender of compressed tiles (or,
-    // uncompressed, a writer per thread at the tiles' own offsets).
+    // The writer side, as rank 0's: the journal, and one appender of compressed tiles.
     Recorder recorder(file, partial, std::move(done), job, layout, tiling, observer);
-    std::vector<std::optional<TileWriter>> writers(threads);
-    std::vector<std::unique_ptr<ExploreWork>> works;
-    for (std::optional<TileWriter>& w : writers) {
-        if (!layout.compressed) w.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
-        works.push_back(make_explore_work(job, grid, tiling, layout, w ? &*w : nullptr, settings.kernel));
-    }
+    const ThreadWorks works = make_works(threads, job, grid, file, settings.kernel);
     const auto on_done = [&](const Flushed& f) { recorder.done(f.reports, f.payload); };
     const std::uint64_t granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
     const auto compute_start = std::chrono::steady_clock::now();
-    const bool interrupted = count_tiles(pending, works, granule, ScheduleSettings{}.report_seconds, on_done, stop);
+    const bool interrupted = count_tiles(pending, works.works, granule, ScheduleSettings{}.report_seconds, on_done, stop);
     const auto compute_end = std::chrono::steady_clock::now();
     summary.compute_seconds = std::chrono::duration<double>(compute_end - compute_start).count();
     observer.computed(summary.compute_seconds);
 
-    FinishReport finish;
-    std::string step = "recording the last tiles in";
     try {
         interrupted ? recorder.checkpoint() : recorder.last();
-        file.close();
-        const double seconds = seconds_since(started);
-        if (interrupted) {
-            step = "recording the run in";
-            record_partial_run(partial, seconds, provenance);
-        } else {
-            step = "finishing the result from";
-            observer.finishing();
-            finish = finish_result(partial, plan.output, result_info(job, grid), tiling, layout, recorder.journal().done(),
-                                   {provenance, earlier_seconds + seconds, true});
-        }
     } catch (const std::exception& e) {
-        throw RunError(fmt::format("{} {} failed: {}", step, partial.string(), e.what()));
+        throw RunError(e.what());
     }
+    file.close();
+    const FinishReport finish = record_or_finish({job, grid, tiling, layout, partial, plan.output, provenance, earlier_seconds,
+                                                  started},
+                                                 recorder.journal().done(), interrupted, observer);
     if (!interrupted) {
         summary.finish_seconds = seconds_since(compute_end);
         summary.raw_bytes = finish.raw_bytes;
         summary.result_bytes = finish.file_bytes;
         summary.sidecar_note = finish.sidecar_note;
     }
-    const std::vector<std::uint64_t> totals = tallies_of(works);
-    summary.points_this_run = totals[outcome_count + 1];
-    summary.points_counted = totals[outcome_count];
-    summary.outcomes.assign(totals.begin(), totals.begin() + outcome_count);
+    add_tallies(summary, works.works);
     summary.peak_rss_mib = peak_rss_mib();
     summary.interrupted = interrupted;
     summary.complete = !interrupted;

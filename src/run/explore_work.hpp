@@ -4,6 +4,7 @@
 // of its own (uncompressed files).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "core/kernels.hpp"
+#include "io/final_result.hpp"
 #include "io/partial_file.hpp"
 #include "io/stored_tiles.hpp"
 #include "job/grid.hpp"
@@ -90,6 +92,31 @@ private:
 // A rank's compressed tiles as a batch: the payload TileWork::flush made, checked against
 // the reports that came with it (std::logic_error if they differ).
 TileBatch batch_of(std::span<const TileReport> tiles, std::span<const std::byte> payload);
+
+// A run's summary before it starts: its files, its ranks, no outcome yet.
+RunSummary first_summary(const ExplorePlan& plan, int ranks);
+
+// Seconds from `t` to now.
+double seconds_since(std::chrono::steady_clock::time_point t);
+
+// A run's partial file once every process has closed it, as the one process that writes it
+// (rank 0, or run_explore_threads) closes it.
+struct ClosingRun {
+    const Job& job;
+    const Grid& grid;
+    const Tiling& tiling;
+    const PartialLayout& layout;
+    const std::filesystem::path& partial;
+    const std::filesystem::path& output;
+    const Provenance& provenance;
+    double earlier_seconds;  // of the runs before a resume
+    std::chrono::steady_clock::time_point started;
+};
+// An interrupted run's seconds recorded in its partial file, or a complete run's result
+// made from it (every tile done, as `done` says). Throws RunError naming the step and the
+// file.
+FinishReport record_or_finish(const ClosingRun& run, std::span<const std::uint8_t> done, bool interrupted,
+                              RunObserver& observer);
 
 // The refusal to resume onto a partial file whose done tiles `bad` (of `done`) no longer
 // match the checksums written with them: the same words from both drivers.
