@@ -246,6 +246,17 @@ StartedPartial start_partial(const fs::path& partial, PlanMode mode, const Job& 
     return p;
 }
 
+// Not larger: a rank waits at the end of its run for its last buffer to reach the file
+// system, and with 8 MiB that wait cost a quarter of `explore -n 2`'s speed on the 4096^2
+// slice (1.54e8 against 2.03e8 points/s, medians of 5 interleaved runs); 2 MiB was no
+// faster and made more than 3 write calls per million points at 8192^2.
+std::uint64_t tile_writer_bytes(const Job& job) { return std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment); }
+
+std::uint64_t handout_granule(const Job& job, const PartialLayout& layout)
+{
+    return layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+}
+
 RunSummary first_summary(const ExplorePlan& plan, int ranks)
 {
     RunSummary summary;
@@ -834,22 +845,14 @@ Counted count_run(OpenRun& run, TilesLeft left, const ExploreSettings& settings,
         writing.sink = &sink.emplace(run.file, job);
     }
 
-    // Uncompressed tiles: each rank writes its own, in pieces of at least one alignment
-    // unit (and 4 MiB of counts), and blocks of tiles are multiples of one where they can
-    // be, so that ranks rarely share a stripe. Not larger: a rank waits at the end of its
-    // run for its last buffer to reach the file system, and with 8 MiB that wait cost a
-    // quarter of `explore -n 2`'s speed on the 4096^2 slice (1.54e8 against 2.03e8
-    // points/s, medians of 5 interleaved runs); 2 MiB was no faster and made more than 3
-    // write calls per million points at 8192^2.
+    // Uncompressed tiles: each rank writes its own.
     std::optional<TileWriter> writer;
-    if (!layout.compressed) writer.emplace(run.file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
+    if (!layout.compressed) writer.emplace(run.file, tile_writer_bytes(job));
     Work work(job, run.grid, run.tiling, layout, writer ? &*writer : nullptr, settings.kernel);
     const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
         run.recorder->done(tiles, payload);
     };
-    // Uncompressed, a granule is an alignment unit of tiles; compressed tiles go to rank 0,
-    // and the granule only groups tiles for the interleaved hand-out.
-    schedule.granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    schedule.granule = handout_granule(job, layout);
     // Every rank holds the hand-out list through the run (4 bytes a tile): made in place
     // from what is left, not beside it.
     const std::vector<ListedTile> pending =

@@ -113,7 +113,7 @@ ThreadWorks make_works(unsigned threads, const Job& job, const Grid& grid, Parti
     t.writers.resize(threads);
     const PartialLayout& layout = file.layout();
     for (std::optional<TileWriter>& w : t.writers) {
-        if (!layout.compressed) w.emplace(file, std::max<std::uint64_t>(std::uint64_t{4} << 20, job.alignment));
+        if (!layout.compressed) w.emplace(file, tile_writer_bytes(job));
         t.works.push_back(make_explore_work(job, grid, file.tiling(), layout, w ? &*w : nullptr, kernel));
     }
     return t;
@@ -165,7 +165,7 @@ RunSummary run_explore_threads(const Job& job, const ExploreSettings& settings, 
     Recorder recorder(file, partial, std::move(done), job, layout, tiling, observer);
     const ThreadWorks works = make_works(threads, job, grid, file, settings.kernel);
     const auto on_done = [&](const Flushed& f) { recorder.done(f.reports, f.payload); };
-    const std::uint64_t granule = layout.compressed ? 1 : std::max<std::uint64_t>(1, job.alignment / layout.counts_chunk());
+    const std::uint64_t granule = handout_granule(job, layout);
     const auto compute_start = std::chrono::steady_clock::now();
     const bool interrupted = count_tiles(pending, works.works, granule, ScheduleSettings{}.report_seconds, on_done, stop);
     const auto compute_end = std::chrono::steady_clock::now();

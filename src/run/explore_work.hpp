@@ -93,6 +93,15 @@ private:
 // the reports that came with it (std::logic_error if they differ).
 TileBatch batch_of(std::span<const TileReport> tiles, std::span<const std::byte> payload);
 
+// The buffer of a writer of uncompressed tiles (TileWriter, one a rank or thread): bytes of
+// counts, at least one alignment unit and 4 MiB, so that each write is whole stripes and
+// ranks rarely share one.
+std::uint64_t tile_writer_bytes(const Job& job);
+// Tiles handed out together (ScheduleSettings::granule): uncompressed, an alignment unit
+// of tiles, so that blocks of tiles are whole stripes where they can be; compressed tiles go
+// to their writer, and the granule only groups tiles for the interleaved hand-out: 1.
+std::uint64_t handout_granule(const Job& job, const PartialLayout& layout);
+
 // A run's summary before it starts: its files, its ranks, no outcome yet.
 RunSummary first_summary(const ExplorePlan& plan, int ranks);
 
