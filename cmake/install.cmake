@@ -3,14 +3,17 @@
 #   P/lib/pythonX.Y/site-packages/superball      the Python module (src/python/CMakeLists.txt)
 #   P/share/superball/jobs/{slurm,pbs}           the batch scripts (they run P/bin/superball)
 #   P/share/superball/analysis                   the figure scripts
-#   P/lib/libsuperball_*.a, P/include/superball  the libraries the program is made of, and
-#   P/lib/cmake/superball                        find_package(superball): superball::run, ...
+#   P/include/superball/superball.hpp            the public C++ API (src/api): the one header
+#   P/lib/libsuperball_*.a                       the libraries: the API's and those it is made of
+#   P/lib/cmake/superball                        find_package(superball): superball::api
+# The internal headers are not installed: what a program may use is the API, what it may not
+# cannot be included.
 # Nothing installed refers to the build tree.
 include(CMakePackageConfigHelpers)
 
 install(TARGETS superball RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT program)
 
-set(superball_libraries core job measures mpi io run)
+set(superball_libraries core job measures mpi io run api)
 set(exported superball_flags)
 foreach(name ${superball_libraries})
   set_target_properties(superball_${name} PROPERTIES EXPORT_NAME ${name})
@@ -26,11 +29,8 @@ set_target_properties(superball_flags PROPERTIES EXPORT_NAME flags)
 install(TARGETS ${exported} EXPORT superballTargets COMPONENT development
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         OBJECTS DESTINATION ${CMAKE_INSTALL_LIBDIR}/superball/objects
-        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/superball)
-install(DIRECTORY src/core src/job src/measures src/mpi src/io src/run DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/superball
-        COMPONENT development FILES_MATCHING PATTERN "*.hpp")
-install(FILES ${CMAKE_BINARY_DIR}/generated/superball/version.hpp
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/superball/superball COMPONENT development)
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES src/api/superball/superball.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/superball COMPONENT development)
 set(package_dir ${CMAKE_INSTALL_LIBDIR}/cmake/superball)
 install(EXPORT superballTargets NAMESPACE superball:: DESTINATION ${package_dir} COMPONENT development)
 configure_package_config_file(cmake/superballConfig.cmake.in ${CMAKE_BINARY_DIR}/superballConfig.cmake

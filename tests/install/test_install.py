@@ -67,9 +67,13 @@ class Installed(unittest.TestCase):
         self.assertEqual(len(python_dir), 1)
         for path in ["bin/superball", "share/superball/jobs/slurm/explore.sbatch", "share/superball/jobs/pbs/explore.pbs",
                      "share/superball/analysis/region_map.py", "share/superball/analysis/superball_results.py",
-                     "lib/cmake/superball/superballConfig.cmake", "include/superball/run/explore.hpp",
-                     "include/superball/superball/version.hpp", "lib/libsuperball_run.a"]:
+                     "lib/cmake/superball/superballConfig.cmake", "include/superball/superball.hpp",
+                     "lib/libsuperball_api.a", "lib/libsuperball_run.a"]:
             self.assertTrue(os.path.exists(os.path.join(self.prefix, path)), path)
+        # The public header alone: no internal one is installed.
+        headers = [os.path.relpath(os.path.join(d, f), self.prefix) for d, _, files in os.walk(os.path.join(self.prefix, "include"))
+                   for f in files]
+        self.assertEqual(headers, ["include/superball/superball.hpp"])
         for name in ("__init__.py", "__init__.pyi", "py.typed"):
             self.assertTrue(os.path.exists(os.path.join(python_dir[0], name)), name)
         binaries = [os.path.join(self.prefix, "bin", "superball")] + glob.glob(os.path.join(python_dir[0], "_core*.so"))
@@ -118,7 +122,10 @@ class Installed(unittest.TestCase):
         self.run_here(superball, "explore", "job.toml", "-o", "for_consumer.h5", "-q")
         r = self.run_here(os.path.join(build, "consumer"), "for_consumer.h5")
         self.assertIn("count 8 left", r.stdout)
+        self.assertIn("threads 8", r.stdout)
+        self.assertIn("refused: e = 1.5 is out of range", r.stdout)
         self.assertIn("points 3072", r.stdout)
+        self.assertIn("complete", r.stdout)
 
 
 if __name__ == "__main__":
