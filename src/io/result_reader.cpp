@@ -449,12 +449,13 @@ void ResultReader::validate_kind()
         format != layout::format_version && !(in.kind == FileKind::result && format >= layout::oldest_result_format &&
                                               format < layout::format_version)) {
         check.fail(in.kind == FileKind::result
-                       ? fmt::format("attribute superball_format = {}: this version of superball reads results of format {} "
+                       ? fmt::format("attribute {format_attr} = {}: this version of superball reads results of format {} "
                                      "to {}; read the file with the version that wrote it",
-                                     format, layout::oldest_result_format, layout::format_version)
-                       : fmt::format("attribute superball_format = {}: a partial file of format {} is resumed by the version "
+                                     format, layout::oldest_result_format, layout::format_version,
+                                     fmt::arg("format_attr", attr::format.name))
+                       : fmt::format("attribute {format_attr} = {}: a partial file of format {} is resumed by the version "
                                      "that wrote it, this one resumes format {} only",
-                                     format, format, layout::format_version));
+                                     format, format, layout::format_version, fmt::arg("format_attr", attr::format.name)));
     }
 }
 
@@ -465,7 +466,8 @@ void ResultReader::validate_axes()
     ResultInfo& in = info_;
     in.coordinate_system = check.text(attr::coordinate_system);
     if (in.coordinate_system != "canonical" && in.coordinate_system != "physical") {
-        check.fail("attribute coordinate_system = \"" + printable(in.coordinate_system) + "\" is neither canonical nor physical");
+        check.fail(fmt::format("attribute {} = \"{}\" is neither canonical nor physical", attr::coordinate_system.name,
+                               printable(in.coordinate_system)));
     }
     const std::vector<std::string> coordinates = coordinates_of(in.coordinate_system);
     in.axis_names = check.texts(attr::axis_names, 4);
@@ -474,17 +476,19 @@ void ResultReader::validate_axes()
     for (const std::string& a : in.axis_names) {
         const auto c = std::find(coordinates.begin(), coordinates.end(), a);
         if (c == coordinates.end() && !is_coefficient(a)) {
-            check.fail(fmt::format("attribute axis_names names \"{}\", which is neither a {} coordinate ({}) nor a model "
+            check.fail(fmt::format("attribute {axis_names_attr} names \"{}\", which is neither a {} coordinate ({}) nor a model "
                                    "coefficient ({})",
                                    printable(a), in.coordinate_system, fmt::join(coordinates, ", "),
-                                   fmt::join(coefficient_names(), ", ")));
+                                   fmt::join(coefficient_names(), ", "),
+                                   fmt::arg("axis_names_attr", attr::axis_names.name)));
         }
-        if (!seen.insert(a).second) check.fail("attribute axis_names names \"" + a + "\" twice");
+        if (!seen.insert(a).second) check.fail(fmt::format("attribute {} names \"{}\" twice", attr::axis_names.name, a));
         // Swept coefficients first, then the coordinates in their order (as written).
         const std::ptrdiff_t order = c == coordinates.end() ? -1 : c - coordinates.begin();
         if (order < last_coordinate) {
-            check.fail(fmt::format("attribute axis_names lists ({}) out of order: swept coefficients first, then {}",
-                                   fmt::join(printable(in.axis_names), ", "), fmt::join(coordinates, ", ")));
+            check.fail(fmt::format("attribute {axis_names_attr} lists ({}) out of order: swept coefficients first, then {}",
+                                   fmt::join(printable(in.axis_names), ", "), fmt::join(coordinates, ", "),
+                                   fmt::arg("axis_names_attr", attr::axis_names.name)));
         }
         last_coordinate = std::max(last_coordinate, order);
     }
@@ -494,8 +498,9 @@ void ResultReader::validate_axes()
         }
     }
     if (in.fixed.size() + 3 < coordinates.size()) {
-        check.fail(fmt::format("attribute axis_names lists {} {} coordinates: a grid has at most 3 ranges",
-                               coordinates.size() - in.fixed.size(), in.coordinate_system));
+        check.fail(fmt::format("attribute {axis_names_attr} lists {} {} coordinates: a grid has at most 3 ranges",
+                               coordinates.size() - in.fixed.size(), in.coordinate_system,
+                               fmt::arg("axis_names_attr", attr::axis_names.name)));
     }
 }
 
@@ -512,8 +517,8 @@ void ResultReader::validate_job_and_model()
     try {
         parse_job(in.job_toml, attr::job_toml.name);
     } catch (const InputError& e) {
-        check.fail(fmt::format("attribute job_toml is not the text of a valid job ({}): the file is damaged",
-                               printable(e.what())));
+        check.fail(fmt::format("attribute {job_toml_attr} is not the text of a valid job ({}): the file is damaged",
+                               printable(e.what()), fmt::arg("job_toml_attr", attr::job_toml.name)));
     }
     in.job_fingerprint = check.text(attr::job_fingerprint, max_job_bytes);
     in.mpi_ranks = check.integer(attr::mpi_ranks, 0, std::int64_t{1} << 40);
@@ -532,13 +537,16 @@ void ResultReader::validate_job_and_model()
     if (h5::has_attribute(file_, attr::mpi_hosts)) in.mpi_hosts = check.integer(attr::mpi_hosts, 1, std::int64_t{1} << 40);
     if (h5::has_attribute(file_, attr::threads)) in.threads = check.integer(attr::threads, 1, std::int64_t{1} << 20);
     in.wall_seconds = check.number(attr::wall_seconds);
-    if (in.wall_seconds < 0) check.fail(fmt::format("attribute wall_seconds = {} is negative", in.wall_seconds));
+    if (in.wall_seconds < 0) check.fail(fmt::format("attribute {wall_seconds_attr} = {} is negative", in.wall_seconds,
+                                                    fmt::arg("wall_seconds_attr", attr::wall_seconds.name)));
     in.complete = check.integer(attr::complete, 0, 1) == 1;
     if (in.kind == FileKind::result && !in.complete) {
-        check.fail("attribute complete = 0 contradicts superball_file = result (a result is written complete)");
+        check.fail(fmt::format("attribute {} = 0 contradicts {} = result (a result is written {complete_attr})", attr::complete.name,
+                               attr::kind.name, fmt::arg("complete_attr", attr::complete.name)));
     }
     if (in.kind == FileKind::partial && in.complete) {
-        check.fail("attribute complete = 1 contradicts superball_file = partial (a run in progress)");
+        check.fail(fmt::format("attribute {} = 1 contradicts {} = partial (a run in progress)", attr::complete.name,
+                               attr::kind.name));
     }
     // A coefficient is a number in its range, or names the axis that sweeps it.
     std::set<std::string> swept;
@@ -562,9 +570,9 @@ void ResultReader::validate_job_and_model()
     }
     for (const std::string& a : in.axis_names) {
         if (is_coefficient(a) && !swept.count(a)) {
-            check.fail(fmt::format("attribute axis_names names the coefficient {0}, but no coefficient attribute says "
+            check.fail(fmt::format("attribute {axis_names_attr} names the coefficient {0}, but no coefficient attribute says "
                                    "\"axis:{0}\"",
-                                   a));
+                                   a, fmt::arg("axis_names_attr", attr::axis_names.name)));
         }
     }
     if (in.coordinate_system == "physical") {
@@ -594,9 +602,10 @@ void ResultReader::validate_no_journal()
                                       flags.size());
             }
         }
-        check.fail(fmt::format("superball_file = result and complete = 1 say the run is complete, but the file holds a resume "
+        check.fail(fmt::format("{kind_attr} = result and {complete_attr} = 1 say the run is {complete_attr}, but the file holds a resume "
                                "journal{}: the file contradicts itself",
-                               journal.empty() ? " (/progress), which only a run in progress has" : journal));
+                               journal.empty() ? " (/progress), which only a run in progress has" : journal,
+                               fmt::arg("complete_attr", attr::complete.name), fmt::arg("kind_attr", attr::kind.name)));
     }
 }
 
@@ -626,8 +635,9 @@ void ResultReader::validate_data()
                                    : ""));
     }
     if (cs.scalar || cs.dims.size() != in.axis_names.size()) {
-        check.fail(fmt::format("/wall_bounces has {} dimensions {} but axis_names lists {} axes ({})", cs.dims.size(),
-                               dims_text(cs.dims), in.axis_names.size(), fmt::join(in.axis_names, ", ")));
+        check.fail(fmt::format("/wall_bounces has {} dimensions {} but {axis_names_attr} lists {} axes ({})", cs.dims.size(),
+                               dims_text(cs.dims), in.axis_names.size(), fmt::join(in.axis_names, ", "),
+                               fmt::arg("axis_names_attr", attr::axis_names.name)));
     }
     if (os.scalar || os.dims != cs.dims) {
         check.fail("/outcome " + dims_text(os.dims) + " and /wall_bounces " + dims_text(cs.dims) + " differ in shape");
@@ -687,8 +697,8 @@ void ResultReader::validate_coordinates()
                                                 std::pair{&outcome_scales, layout::outcome}}) {
             const std::vector<haddr_t>& s = (*scales)[k];
             if (std::find(s.begin(), s.end(), at) == s.end()) {
-                check.fail(fmt::format("{} is not attached to dimension {} of {}, which axis_names says is {}", name, k,
-                                       data_name, in.axis_names[k]));
+                check.fail(fmt::format("{} is not attached to dimension {} of {}, which {axis_names_attr} says is {}", name, k,
+                                       data_name, in.axis_names[k], fmt::arg("axis_names_attr", attr::axis_names.name)));
             }
         }
     }
@@ -704,7 +714,7 @@ void ResultReader::validate_coordinates()
         check.allocated(d, v);
         double x = 0;
         h5::read(d, std::span(&x, 1), v);
-        if (!(x == value)) check.fail(fmt::format("{} = {} contradicts attribute fixed_{} = {}", v, x, name, value));
+        if (!(x == value)) check.fail(fmt::format("{} = {} contradicts attribute {}{} = {}", v, x, attr::fixed_prefix, name, value));
     }
 }
 
@@ -722,8 +732,8 @@ void ResultReader::validate_tiles()
     in.tile_shape = check.integers(attr::tile_shape, in.shape.size());
     for (std::size_t k = 0; k < in.shape.size(); ++k) {
         if (in.tile_shape[k] < 1 || in.tile_shape[k] > in.shape[k]) {
-            check.fail(fmt::format("attribute tile_shape = ({}) does not fit the data ({})", fmt::join(in.tile_shape, ", "),
-                                   fmt::join(in.shape, ", ")));
+            check.fail(fmt::format("attribute {tile_shape_attr} = ({}) does not fit the data ({})", fmt::join(in.tile_shape, ", "),
+                                   fmt::join(in.shape, ", "), fmt::arg("tile_shape_attr", attr::tile_shape.name)));
         }
     }
     tiling_.emplace(in.shape, in.tile_shape);
@@ -740,11 +750,11 @@ void ResultReader::validate_tiles()
         const bool pipeline = compressed_ ? st.filters == 2 && st.shuffle && st.deflate_level >= 1 && st.deflate_level <= 9
                                           : st.filters == 0;
         if (st.chunk != std::vector<hsize_t>(in.tile_shape.begin(), in.tile_shape.end()) || !pipeline || !as_counts) {
-            check.fail(fmt::format("{} is stored {}{}, not in chunks of tile_shape ({}), uncompressed or through shuffle and "
+            check.fail(fmt::format("{} is stored {}{}, not in chunks of {tile_shape_attr} ({}), uncompressed or through shuffle and "
                                    "deflate alike for both datasets, as a partial file is",
                                    name, st.chunk.empty() ? "unchunked" : "in chunks of " + dims_text(st.chunk),
                                    st.filters ? fmt::format(" through {} filters", st.filters) : "",
-                                   fmt::join(in.tile_shape, ", ")));
+                                   fmt::join(in.tile_shape, ", "), fmt::arg("tile_shape_attr", attr::tile_shape.name)));
         }
         if (!compressed_) {
             check.allocated(d, name);
@@ -771,8 +781,9 @@ void ResultReader::validate_journal()
         const std::size_t bytes = name == layout::tile_done ? 1 : 8;
         const std::vector<hsize_t> dims = name == layout::tile_stored ? std::vector<hsize_t>{in.tiles, 3} : std::vector<hsize_t>{in.tiles};
         if (s.type != h5::TypeClass::integer || s.is_signed || s.bytes != bytes || !s.little_endian || s.dims != dims) {
-            check.fail(fmt::format("{} holds {} but tile_shape ({}) makes {} tiles: accepted {} unsigned {}-bit integers",
-                                   name, shape_text(s), fmt::join(in.tile_shape, ", "), in.tiles, dims_text(dims), 8 * bytes));
+            check.fail(fmt::format("{} holds {} but {tile_shape_attr} ({}) makes {} tiles: accepted {} unsigned {}-bit integers",
+                                   name, shape_text(s), fmt::join(in.tile_shape, ", "), in.tiles, dims_text(dims), 8 * bytes,
+                                   fmt::arg("tile_shape_attr", attr::tile_shape.name)));
         }
         check.allocated(d, name);
     }

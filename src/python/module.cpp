@@ -376,14 +376,16 @@ py::dict validate(const std::string& path)
         counts = reader.outcome_counts();
     }
     py::dict d;
-    d["coordinate_system"] = info.coordinate_system;
-    d["axis_names"] = info.axis_names;
+    // Keyed as the file's attributes are.
+    namespace attr = layout::attr;
+    d[attr::coordinate_system.name] = info.coordinate_system;
+    d[attr::axis_names.name] = info.axis_names;
     d["shape"] = info.shape;
-    d["max_bounces"] = info.max_bounces;
-    d["software_version"] = info.software_version;
-    d["history"] = info.history;
-    d["source"] = info.source;
-    d["date_created"] = info.date_created;
+    d[attr::max_bounces.name] = info.max_bounces;
+    d[attr::software_version.name] = info.software_version;
+    d[attr::history.name] = info.history;
+    d[attr::source.name] = info.source;
+    d[attr::date_created.name] = info.date_created;
     py::dict outcomes;
     for (int o = 0; o < outcome_count; ++o) outcomes[py::str(std::string(name(static_cast<Outcome>(o))))] = counts.by_outcome[static_cast<std::size_t>(o)];
     d["outcomes"] = outcomes;

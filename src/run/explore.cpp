@@ -92,11 +92,11 @@ Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const
     const Extent shape = Grid(job).shape();
     const std::size_t bytes = count_bytes(job);
     if (info.shape != shape || info.count_bytes != bytes) {
-        return refuse(fmt::format("{} is damaged: its data ({}, {}-bit counts) contradict its job_fingerprint ({}, {}-bit "
+        return refuse(fmt::format("{} is damaged: its data ({}, {}-bit counts) contradict its {} ({}, {}-bit "
                                   "counts); refusing to resume onto it: --overwrite to start again, or --output to write "
                                   "elsewhere",
                                   partial.string(), fmt::join(info.shape, " x "), 8 * info.count_bytes,
-                                  fmt::join(shape, " x "), 8 * bytes));
+                                  layout::attr::job_fingerprint.name, fmt::join(shape, " x "), 8 * bytes));
     }
     if (info.software_version != software_version) {
         return refuse(fmt::format("{} was made by superball {}, this is {}; refusing to mix results of two versions: use "

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "core/input.hpp"
+#include "io/layout.hpp"
 #include "job/result_json.hpp"
 
 namespace superball::serve {
@@ -38,7 +39,7 @@ Layer::Layer(const std::filesystem::path& path) : reader_(path)
         throw InputError(name + " is a " + info.coordinate_system +
                          " result: accepted canonical results (axes among xi, U, W) as layers");
     }
-    job_ = parse_job(info.job_toml, name + " (its job_toml attribute)");
+    job_ = parse_job(info.job_toml, name + " (its " + layout::attr::job_toml.name + " attribute)");
     if (!job_.parameters.empty()) {
         throw InputError(name + " sweeps a model coefficient: accepted results of one model as layers");
     }
