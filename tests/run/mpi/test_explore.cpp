@@ -244,7 +244,9 @@ TEST(RunExplore, ManyWritersWriteTheSameResult)
         ASSERT_TRUE(r.complete);
         const int expected = writers == 0 ? 1 : std::min<int>(static_cast<int>(writers), nodes);  // auto: 1 below 64 ranks
         EXPECT_EQ(r.schedule.writers, expected) << "writers " << writers;
-        if (expected > 1) {
+        // A leader writes its node's tiles: when every rank counted some (on a loaded machine
+        // the first node's ranks can count every tile before the second's start).
+        if (expected > 1 && r.schedule.tiles_min > 0) {
             EXPECT_GT(r.schedule.placed_max, 0u) << "a leader wrote tiles";
         }
         if (world.is_root()) {
