@@ -555,20 +555,15 @@ Id simple_space(const std::vector<hsize_t>& dims)
 
 void read_rows(hid_t dataset, hsize_t first, hsize_t rows, std::span<std::uint64_t> out, const std::string& what)
 {
-    const Id space = space_id(H5Dget_space(dataset), "H5Dget_space " + what);
-    const int rank = H5Sget_simple_extent_ndims(space);
-    if (rank < 1 || rank > 2) throw Error(what + ": a dataset of one or two dimensions expected");
-    std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-    check(H5Sget_simple_extent_dims(space, dims.data(), nullptr), "H5Sget_simple_extent_dims " + what);
+    const std::vector<hsize_t> dims = dataset_shape(dataset);
+    if (dims.empty() || dims.size() > 2) throw Error(what + ": a dataset of one or two dimensions expected");
     std::vector<hsize_t> start{first}, count{rows};
-    if (rank == 2) {
+    if (dims.size() == 2) {
         start.push_back(0);
         count.push_back(dims[1]);
     }
-    if (out.size() != rows * (rank == 2 ? dims[1] : 1)) throw std::logic_error("read_rows " + what + ": wrong buffer size");
-    select_box(space, start, count);
-    const Id memory = simple_space(count);
-    check(H5Dread(dataset, H5T_NATIVE_UINT64, memory, space, H5P_DEFAULT, out.data()), "read " + what);
+    if (out.size() != rows * (dims.size() == 2 ? dims[1] : 1)) throw std::logic_error("read_rows " + what + ": wrong buffer size");
+    read_box(dataset, start, count, out, what);
 }
 
 Id create_dataset(hid_t loc, const std::string& path, hid_t type, const std::vector<hsize_t>& dims, const Creation& how)

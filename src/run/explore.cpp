@@ -432,7 +432,6 @@ private:
     std::vector<std::uint8_t> outcomes_, chunk_outcomes_;
 };
 
-
 // Rank 0's append buffer, and a writer's: 8 MiB, or a stripe if larger.
 std::uint64_t append_buffer_bytes(const Job& job) { return std::max<std::uint64_t>(std::uint64_t{8} << 20, job.alignment); }
 
@@ -675,10 +674,10 @@ TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& p
     // is built (50 MiB for 16 MiB of it at 2 million tiles).
     std::uint64_t done_count = 0;
     for (const std::uint64_t word : bits) done_count += static_cast<std::uint64_t>(std::popcount(word));
+    left.done = done_count;
     left.pending.reserve(tiling.tiles() - done_count);
     for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
         if (is_done(t)) {
-            ++left.done;
             if (comm.is_root()) left.points_done += tiling.box(t).points();
         } else {
             left.pending.push_back(static_cast<ListedTile>(t));
