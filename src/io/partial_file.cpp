@@ -156,14 +156,13 @@ double record_partial_run(const std::filesystem::path& path, double seconds, con
 
 // ------------------------------------------------------------------------- PartialFile
 
-PartialFile::PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout)
-    : path_(path), comm_(&comm), tiling_(std::move(tiling)), layout_(layout)
+PartialFile::PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout)
+    : path_(path), tiling_(std::move(tiling)), layout_(layout), file_(std::in_place, path)
 {
 }
 
-// Opened at once: the threads of the run share the descriptor.
-PartialFile::PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout)
-    : path_(path), comm_(nullptr), tiling_(std::move(tiling)), layout_(layout), file_(std::in_place, path)
+PartialFile::PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout, OnFirstUse)
+    : path_(path), tiling_(std::move(tiling)), layout_(layout)
 {
 }
 
@@ -213,13 +212,7 @@ std::vector<std::uint64_t> PartialFile::damaged(std::span<const std::uint64_t> d
             i += n;
         }
     }
-    if (!comm_) return bad;
-    // Every rank's findings, in tile order (the shares are in order).
-    std::vector<double> mine(bad.begin(), bad.end());
-    std::vector<double> all = comm_->gather(mine);
-    std::vector<std::uint64_t> out(all.begin(), all.end());
-    comm_->broadcast(out);
-    return out;
+    return bad;
 }
 
 // ---------------------------------------------------------------------------- TileBatch

@@ -33,7 +33,6 @@
 #include "job/job.hpp"
 #include "job/provenance.hpp"
 #include "job/tiles.hpp"
-#include "mpi/mpi.hpp"
 #include "page_buffer.hpp"
 #include "posix_file.hpp"
 #include "stored_tiles.hpp"
@@ -72,16 +71,17 @@ PartialLayout partial_layout(const std::filesystem::path& path, const Tiling& ti
 // every byte of the file (chunks appended past HDF5's own end included).
 double record_partial_run(const std::filesystem::path& path, double seconds, const Provenance& run);
 
-// The partial file of a run, opened by each rank that uses it on a descriptor of its own.
+// The partial file of a run, opened by each process that uses it on a descriptor of its own.
 class PartialFile {
 public:
-    // A rank opens the file when it first uses it: of a compressed run only the writers and
-    // a resume's checks do, so thousands of ranks do not queue at the file system's metadata
-    // server to open a file they never touch.
-    PartialFile(const std::filesystem::path& path, const mpi::Comm& comm, Tiling tiling, const PartialLayout& layout);
-    // For a run in one process without MPI (run/explore_threads.hpp): its threads share the
-    // one descriptor (positioned reads and writes), and damaged() checks every tile here.
+    // Opened at once: the threads of a run in one process share the descriptor (positioned
+    // reads and writes).
     PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout);
+    // Opened when first used, by a rank of a run over MPI: of a compressed run only the
+    // writers and a resume's checks do, so thousands of ranks do not queue at the file
+    // system's metadata server to open a file they never touch.
+    struct OnFirstUse {};
+    PartialFile(const std::filesystem::path& path, Tiling tiling, const PartialLayout& layout, OnFirstUse);
 
     const Tiling& tiling() const { return tiling_; }
     const PartialLayout& layout() const { return layout_; }
@@ -89,10 +89,9 @@ public:
     // Opens the file on first use (std::system_error naming it if it cannot).
     const PosixFile& file() const;
 
-    // Collective: of the tiles `done` with the checksums recorded for them (and,
-    // compressed, where they lie), those whose data no longer match, on every rank. Each rank
-    // gives its share of the done tiles, ascending, the shares in rank order (one process:
-    // all of them).
+    // Of the tiles `done` (ascending) with the checksums recorded for them (and, compressed,
+    // where they lie), those whose data no longer match. A run over several processes gives
+    // each a share and gathers what they found (run/lifecycle.cpp).
     std::vector<std::uint64_t> damaged(std::span<const std::uint64_t> done, std::span<const std::uint64_t> checksums,
                                        std::span<const StoredChunk> stored);
 
@@ -104,10 +103,9 @@ public:
 
 private:
     std::filesystem::path path_;
-    const mpi::Comm* comm_;  // nullptr: one process
     Tiling tiling_;
     PartialLayout layout_;
-    mutable std::optional<PosixFile> file_;  // opened by file(); the one-process run opens it at once
+    mutable std::optional<PosixFile> file_;  // opened by file() (OnFirstUse), else at once
 };
 
 // Places a tile's values, row-major over its box, in the layout of its chunk: row-major

@@ -26,8 +26,8 @@
 #include "job/grid.hpp"
 #include "job/provenance.hpp"
 #include "run/explore_work.hpp"
+#include "run/lifecycle.hpp"
 #include "run/refine.hpp"
-#include "run/root_acts.hpp"
 #include "run/tile_counter.hpp"
 #include "superball/version.hpp"
 
@@ -306,14 +306,6 @@ double peak_rss_mib()
 }
 
 namespace {
-
-void broadcast(const mpi::Comm& comm, PartialLayout& l)
-{
-    std::vector<std::uint64_t> v{l.compressed ? 1u : 0u, l.level, l.counts_at, l.outcomes_at, l.done_at, l.checksums_at,
-                                 l.stored_at, l.count_bytes, l.chunk_points, l.tiles};
-    comm.broadcast(v);
-    l = {v[0] != 0, v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]};
-}
 
 // Counts tiles and hands them on: compressed, into a batch that goes to rank 0 with the
 // rank's reports (TileWork::flush); uncompressed, to the rank's TileWriter.
@@ -594,275 +586,17 @@ ExplorePlan plan_of(const Decision& d, const fs::path& out)
 
 }  // namespace
 
-ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm)
+ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const Team& team)
 {
     const fs::path out = output_path(job, settings);
     Decision d;
-    if (comm.is_root()) d = decide_or_refuse(settings, out, job);
-    d.verdict = static_cast<Verdict>(comm.broadcast(static_cast<std::int64_t>(d.verdict)));
-    comm.broadcast(d.message);
+    if (team.is_root()) d = decide_or_refuse(settings, out, job);
+    d.verdict = static_cast<Verdict>(team.broadcast(static_cast<std::int64_t>(d.verdict)));
+    d.message = team.broadcast(std::move(d.message));
     return plan_of(d, out);
 }
 
-ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings)
-{
-    const fs::path out = output_path(job, settings);
-    return plan_of(decide_or_refuse(settings, out, job), out);
-}
-
 namespace {
-
-// What rank 0 found or made (start_partial), on every rank; a failure on rank 0 thrown on
-// every rank.
-StartedPartial start_everywhere(const mpi::Comm& comm, const fs::path& partial, PlanMode mode, const Job& job,
-                                const Grid& grid, const Provenance& provenance)
-{
-    StartedPartial started;
-    root_acts(comm, [&] { started = start_partial(partial, mode, job, grid, comm.size(), provenance); });
-    comm.broadcast(started.tile_shape);
-    broadcast(comm, started.layout);
-    return started;
-}
-
-// The tiles left to compute and how many are done, on every rank, and their points on rank
-// 0, which reports them (from rank 0's journal). A resume first checks that the done tiles
-// still hold what was written: each rank checks a share, and is sent only its share's
-// checksums and places, which rank 0 reads from the journal a share at a time (every rank
-// holding all of them, 40 bytes a done tile, was the most memory a rank of a resume at
-// thousands of ranks took; rank 0 holding all of them at once, 32: tests/scale/README.md).
-struct TilesLeft {
-    std::vector<ListedTile> pending;
-    std::uint64_t done = 0;
-    std::uint64_t points_done = 0;  // on rank 0
-};
-
-// A share's record as one message: its checksums, then (compressed) where each tile lies.
-std::vector<std::uint64_t> words_of(const JournalRecord& r)
-{
-    std::vector<std::uint64_t> words = r.checksums;
-    for (const StoredChunk& c : r.stored) words.insert(words.end(), {c.address, c.counts_bytes, c.outcomes_bytes});
-    return words;
-}
-
-JournalRecord record_of(const std::vector<std::uint64_t>& words, std::size_t tiles, bool compressed)
-{
-    JournalRecord r;
-    r.checksums.assign(words.begin(), words.begin() + static_cast<std::ptrdiff_t>(tiles));
-    for (std::size_t i = 0; compressed && i < tiles; ++i) {
-        const std::size_t at = tiles + 3 * i;
-        r.stored.push_back({words[at], words[at + 1], words[at + 2]});
-    }
-    return r;
-}
-
-TilesLeft tiles_left(const mpi::Comm& comm, PartialFile& file, const fs::path& partial, PlanMode mode,
-                     std::span<const std::uint8_t> done, const Tiling& tiling)
-{
-    if (tiling.tiles() > max_run_tiles) {  // a file no run of this version makes (default_tiling)
-        throw InputError(fmt::format("{} holds {} tiles: a run takes at most {}", partial.string(), tiling.tiles(), max_run_tiles));
-    }
-    // The done flags, a bit a tile.
-    std::vector<std::uint64_t> bits;
-    if (comm.is_root()) {
-        bits.assign((done.size() + 63) / 64, 0);
-        for (std::uint64_t t = 0; t < done.size(); ++t) bits[t / 64] |= std::uint64_t{done[t] != 0} << (t % 64);
-    }
-    comm.broadcast(bits);
-    const auto is_done = [&](std::uint64_t t) { return ((bits[t / 64] >> (t % 64)) & 1u) != 0; };
-    TilesLeft left;
-    // Reserved: grown by doubling, the list would take up to three times its size while it
-    // is built (50 MiB for 16 MiB of it at 2 million tiles).
-    std::uint64_t done_count = 0;
-    for (const std::uint64_t word : bits) done_count += static_cast<std::uint64_t>(std::popcount(word));
-    left.done = done_count;
-    left.pending.reserve(tiling.tiles() - done_count);
-    for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-        if (is_done(t)) {
-            if (comm.is_root()) left.points_done += tiling.box(t).points();
-        } else {
-            left.pending.push_back(static_cast<ListedTile>(t));
-        }
-    }
-    if (mode != PlanMode::resume) return left;
-    // Rank r checks the done tiles [n r / P, n (r + 1) / P) of the n in order.
-    const auto ranks = static_cast<std::uint64_t>(comm.size());
-    const auto share_begin = [&](std::uint64_t r) { return left.done * r / ranks; };
-    constexpr int tag_share = 31;  // before the schedule: no other message is in flight
-    const bool compressed = file.layout().compressed;
-    std::vector<std::uint64_t> mine;  // this rank's share of the done tiles
-    JournalRecord record;
-    if (comm.is_root()) {
-        // One pass over the done tiles: each share sent as soon as it is whole.
-        std::vector<std::uint64_t> share;
-        std::uint64_t r = 0;
-        const auto pass_on = [&] {
-            if (r == 0) {
-                record = read_journal(file, share);
-                mine = std::move(share);
-            } else {
-                comm.send(words_of(read_journal(file, share)), static_cast<int>(r), tag_share);
-            }
-            share.clear();
-            ++r;
-        };
-        for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-            if (!is_done(t)) continue;
-            while (share_begin(r) + share.size() == share_begin(r + 1)) pass_on();
-            share.push_back(t);
-        }
-        while (r < ranks) pass_on();
-    } else {
-        const auto rank = static_cast<std::uint64_t>(comm.rank());
-        for (std::uint64_t t = 0, i = 0; t < tiling.tiles() && i < share_begin(rank + 1); ++t) {
-            if (is_done(t) && i++ >= share_begin(rank)) mine.push_back(t);
-        }
-        record = record_of(comm.receive(mine.size() * (compressed ? 4 : 1), 0, tag_share), mine.size(), compressed);
-    }
-    if (const std::vector<std::uint64_t> bad = file.damaged(mine, record.checksums, record.stored); !bad.empty()) {
-        file.close();
-        throw damaged_partial(partial, bad, left.done);
-    }
-    return left;
-}
-
-// What the run's note says of its writers when they are not what was asked: `asked` (0:
-// auto) for a compressed file, `writers` chosen.
-std::string writers_note(int asked, int writers, const PartialLayout& layout)
-{
-    if (!layout.compressed && asked > 1) {
-        return "every rank writes its own tiles to an uncompressed result ([run] compression = 0): writers = " +
-               std::to_string(asked) + " does not apply";
-    }
-    if (asked <= writers) return "";
-    return fmt::format("{} writers asked, {} write{}: writers are rank 0 and node leaders, at most one per node "
-                       "(--node-ranks N makes nodes of N ranks on one machine)",
-                       asked, writers, writers == 1 ? "s" : "");
-}
-
-std::string join_notes(const std::string& a, const std::string& b)
-{
-    return a.empty() ? b : b.empty() ? a : a + "; " + b;
-}
-
-// A run of run_explore once its partial file is made or read, on every rank: what it
-// counts, the file, and rank 0's record of it.
-struct OpenRun {
-    OpenRun(const mpi::Comm& comm, const Job& job, const ExplorePlan& plan, const Provenance& provenance,
-            std::chrono::steady_clock::time_point started)
-        : comm(comm),
-          job(job),
-          plan(plan),
-          provenance(provenance),
-          started(started),
-          partial(layout::partial_path(plan.output)),
-          grid(job),
-          start(start_everywhere(comm, partial, plan.mode, job, grid, provenance)),
-          tiling(grid.shape(), start.tile_shape),
-          file(partial, comm, tiling, start.layout)
-    {
-    }
-    const mpi::Comm& comm;
-    const Job& job;
-    const ExplorePlan& plan;
-    const Provenance& provenance;
-    const std::chrono::steady_clock::time_point started;
-    const fs::path partial;
-    const Grid grid;
-    StartedPartial start;  // its done flags go to the recorder
-    const Tiling tiling;
-    PartialFile file;
-    std::optional<Recorder> recorder;  // rank 0's
-};
-
-// What rank 0 does with the partial file once the tiles are counted: an interrupted run's
-// seconds recorded in it, a complete run's result made from it. A failure on rank 0 is
-// thrown on every rank.
-FinishReport close_run(OpenRun& run, bool interrupted, RunObserver& observer)
-{
-    const mpi::Comm& comm = run.comm;
-    FinishReport finish;
-    std::optional<Failure> failure;
-    if (comm.is_root()) {
-        failure = attempt([&] {
-            if (interrupted) {
-                run.recorder->checkpoint();
-            } else {
-                run.recorder->last();
-            }
-        });
-    }
-    // The run's figures, in the partial file (a stop) or the result (complete), by rank 0
-    // alone once every rank has closed the file.
-    run.file.close();
-    comm.barrier();
-    if (comm.is_root() && !failure) {
-        failure = attempt([&] {
-            finish = record_or_finish({run.job, run.grid, run.tiling, run.start.layout, run.partial, run.plan.output,
-                                       run.provenance, run.start.earlier_seconds, run.started},
-                                      run.recorder->journal().done(), interrupted, observer);
-        });
-    }
-    throw_everywhere(comm, failure);
-    return finish;
-}
-
-// The tiles of a run counted: how the schedule went, the tallies of this rank's points,
-// when counting ended.
-struct Counted {
-    ScheduleResult schedule;
-    std::vector<std::uint64_t> tallies;  // ExploreWork::tallies
-    double compute_seconds = 0;          // the same on every rank
-    std::chrono::steady_clock::time_point end;
-};
-
-// Collective: the tiles `left` counted by the ranks under the schedule, rank 0 recording
-// them (run.recorder, made here).
-Counted count_run(OpenRun& run, TilesLeft left, const ExploreSettings& settings, RunObserver& observer,
-                  const StopRequested& stop)
-{
-    const mpi::Comm& comm = run.comm;
-    const Job& job = run.job;
-    const PartialLayout& layout = run.start.layout;
-    ScheduleSettings schedule;
-    schedule.node_ranks = settings.node_ranks;
-    schedule.writers = static_cast<int>(settings.writers.value_or(job.writers));
-    const int writers = layout.compressed ? schedule_writers(comm, schedule) : 1;
-    if (comm.is_root()) {
-        observer.started({run.plan.output, join_notes(run.plan.note, writers_note(schedule.writers, writers, layout)),
-                          comm.size(), job.points(), run.tiling.tiles(), run.tiling.box(0).points(), left.done,
-                          left.points_done});
-        run.recorder.emplace(run.file, run.partial, std::move(run.start.done), job, layout, run.tiling, observer, writers);
-    }
-    // Several writers: rank 0 records where the others wrote and grants them file space;
-    // each rank but 0 holds a sink, used if the schedule makes it a writer.
-    std::optional<AppenderSink> sink;
-    Writers writing;
-    if (writers > 1 && comm.is_root()) {
-        writing.placed = [&](std::span<const AppendedTile> tiles) { run.recorder->placed(tiles); };
-        writing.grant = [&](std::uint64_t bytes) { return run.recorder->grant(bytes); };
-    } else if (writers > 1) {
-        writing.sink = &sink.emplace(run.file, job);
-    }
-
-    // Uncompressed tiles: each rank writes its own.
-    std::optional<TileWriter> writer;
-    if (!layout.compressed) writer.emplace(run.file, tile_writer_bytes(job));
-    Work work(job, run.grid, run.tiling, layout, writer ? &*writer : nullptr, settings.kernel);
-    const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
-        run.recorder->done(tiles, payload);
-    };
-    schedule.granule = handout_granule(job, layout);
-    // Every rank holds the hand-out list through the run (4 bytes a tile): made in place
-    // from what is left, not beside it.
-    const std::vector<ListedTile> pending =
-        handout_order(std::move(left.pending), schedule.granule, comm.size() >= settings.interleave_ranks);
-    const auto compute_start = std::chrono::steady_clock::now();
-    Counted c{run_schedule(comm, pending, work, on_done, stop, schedule, writing), work.tallies(), 0,
-              std::chrono::steady_clock::now()};
-    c.compute_seconds = comm.broadcast(std::chrono::duration<double>(c.end - compute_start).count());
-    if (comm.is_root()) observer.computed(c.compute_seconds);
-    return c;
-}
 
 // Collective: every rank's ScheduleStats reduced to the run's figures (rank 0's own where
 // they are a server's). Four small reductions at the end of a run.
@@ -895,6 +629,41 @@ ScheduleFigures schedule_figures(const mpi::Comm& comm, const ScheduleStats& min
 
 }  // namespace
 
+Counted count_on_ranks(OpenRun& run, std::vector<ListedTile> pending, const ExploreSettings& settings,
+                       const StopRequested& stop)
+{
+    const mpi::Comm& comm = *run.team.comm();
+    const Job& job = run.job;
+    const PartialLayout& layout = run.start.layout;
+    // Several writers: rank 0 records where the others wrote and grants them file space;
+    // each rank but 0 holds a sink, used if the schedule makes it a writer.
+    std::optional<AppenderSink> sink;
+    Writers writing;
+    if (run.writers > 1 && comm.is_root()) {
+        writing.placed = [&](std::span<const AppendedTile> tiles) { run.recorder->placed(tiles); };
+        writing.grant = [&](std::uint64_t bytes) { return run.recorder->grant(bytes); };
+    } else if (run.writers > 1) {
+        writing.sink = &sink.emplace(run.file, job);
+    }
+    // Uncompressed tiles: each rank writes its own.
+    std::optional<TileWriter> writer;
+    if (!layout.compressed) writer.emplace(run.file, tile_writer_bytes(job));
+    Work work(job, run.grid, run.tiling, layout, writer ? &*writer : nullptr, settings.kernel);
+    const TilesDone on_done = [&](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
+        run.recorder->done(tiles, payload);
+    };
+    ScheduleSettings schedule = schedule_settings(settings, job);
+    schedule.granule = handout_granule(job, layout);
+    // Every rank holds the hand-out list through the run (4 bytes a tile): made in place
+    // from what is left, not beside it.
+    pending = handout_order(std::move(pending), schedule.granule, comm.size() >= settings.interleave_ranks);
+    const auto compute_start = std::chrono::steady_clock::now();
+    const ScheduleResult r = run_schedule(comm, pending, work, on_done, stop, schedule, writing);
+    Counted c{r.interrupted, work.tallies(), 0, std::chrono::steady_clock::now(), schedule_figures(comm, r.stats)};
+    c.compute_seconds = comm.broadcast(std::chrono::duration<double>(c.end - compute_start).count());
+    return c;
+}
+
 DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks)
 {
     const fs::path out = output_path(job, settings);
@@ -924,43 +693,7 @@ DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int rank
 RunSummary run_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm, RunObserver& observer,
                        const StopRequested& stop)
 {
-    const auto started = std::chrono::steady_clock::now();
-    const ExplorePlan plan = plan_explore(job, settings, comm);
-    const Provenance provenance = run_provenance(settings, comm.size(), mpi::host_count(comm), 1);
-    RunSummary summary = first_summary(plan, comm.size());
-    if (plan.mode == PlanMode::complete) {
-        if (comm.is_root()) observer.started({plan.output, plan.note, comm.size(), job.points(), 0, 0, 0, 0});
-        summary.complete = summary.nothing_to_do = true;
-        return summary;
-    }
-
-    // The partial file and its journal: made by rank 0 (a new run) or read (a resume).
-    OpenRun run(comm, job, plan, provenance, started);
-    Counted counted = count_run(run, tiles_left(comm, run.file, run.partial, plan.mode, run.start.done, run.tiling), settings,
-                                observer, stop);
-    const bool interrupted = counted.schedule.interrupted;
-    const FinishReport finish = close_run(run, interrupted, observer);
-    if (!interrupted) {
-        // From the last tile counted to the result under its name.
-        summary.finish_seconds = comm.broadcast(comm.is_root() ? seconds_since(counted.end) : 0.0);
-        summary.raw_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(finish.raw_bytes)));
-        summary.result_bytes = static_cast<std::uint64_t>(comm.broadcast(static_cast<std::int64_t>(finish.file_bytes)));
-        summary.sidecar_note = finish.sidecar_note;
-        comm.broadcast(summary.sidecar_note);
-    }
-
-    std::vector<std::uint64_t> totals = comm.sum(counted.tallies);  // with the histogram: one reduction
-    summary.points_this_run = totals.back();
-    totals.pop_back();
-    summary.points_counted = totals.back();
-    totals.pop_back();
-    summary.outcomes = std::move(totals);
-    summary.compute_seconds = counted.compute_seconds;
-    summary.peak_rss_mib = comm.max(peak_rss_mib());
-    summary.schedule = schedule_figures(comm, counted.schedule.stats);
-    summary.interrupted = interrupted;
-    summary.complete = !interrupted;
-    return summary;
+    return run_lifecycle(job, settings, Team::ranks(comm), observer, stop);
 }
 
 }  // namespace superball

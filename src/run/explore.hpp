@@ -7,8 +7,9 @@
 //   finish: rank 0 makes the partial file the result in place (io/final_result.hpp), or
 //           records the interrupted run in it, resumable.
 //
-// Progress goes to a RunObserver (rank 0 only); a stop is asked for through a predicate
-// polled on every rank (StopSignals::requested for the command line).
+// Progress goes to rank 0's RunObserver (run/progress.hpp); a stop is asked for through a
+// predicate polled on every rank (StopSignals::requested for the command line). The run's
+// steps are run/lifecycle.hpp's, the same as run_explore_threads'.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +26,7 @@
 #include "mpi/mpi.hpp"
 #include "run/progress.hpp"
 #include "run/schedule.hpp"
+#include "run/team.hpp"
 
 namespace superball {
 
@@ -63,15 +65,13 @@ struct ExplorePlan {
     std::string note;  // for the user: what was decided and why (may be empty)
 };
 
-// Collective. Decides on rank 0 what to do with the output (a result, written when the run
-// completes) and its partial file (OUTPUT.partial, the run in progress), and tells every
-// rank. Throws InputError (on every rank, same text) when they must not be touched: the
-// output exists and neither --resume nor --overwrite says what to do with it, it is not a
-// superball file (never replaced, even with --overwrite), it belongs to another job or
-// version, or it cannot be written.
-ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const mpi::Comm& comm);
-// The same decision for a run in this process alone (run/explore_threads.hpp: no MPI).
-ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings);
+// Collective over `team` (run/team.hpp). Decides on the root what to do with the output (a
+// result, written when the run completes) and its partial file (OUTPUT.partial, the run in
+// progress), and tells every process. Throws InputError (on every process, same text) when
+// they must not be touched: the output exists and neither --resume nor --overwrite says
+// what to do with it, it is not a superball file (never replaced, even with --overwrite), it
+// belongs to another job or version, or it cannot be written.
+ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const Team& team);
 
 // What `superball explore --dry-run` shows: the run planned for `ranks` ranks, without
 // running it or touching a file. `plan`/`refusal`: plan_explore's decision; the rest, the

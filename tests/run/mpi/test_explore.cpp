@@ -1,8 +1,8 @@
 // run_explore (run/explore.hpp) under MPI, at whatever rank count the test runs with
-// (ctest: 1 to 4): the result equals the kernel applied point by point, with no MPI, so
-// every rank count gives the same file; a run stopped part-way keeps only its partial
-// file and --resume completes it to the same result; refinement does not depend on the
-// rank count; rank 0's observer sees every tile once; plans refuse alike on every rank.
+// (ctest: 1 to 4), where it differs from a run on threads (the lifecycle both share:
+// tests/run/lifecycle_suite.hpp): the schedule's figures, many writers, the interleaved
+// hand-out, compressed and uncompressed data after a stop, a finish interrupted half-way,
+// refinement independent of the rank count, plans refused alike on every rank.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -22,6 +22,7 @@
 #include "mpi/mpi.hpp"
 #include "run/explore.hpp"
 #include "../explore_fixture.hpp"
+#include "shared_dir.hpp"
 #include "run/refine.hpp"
 #include "run/tile_counter.hpp"
 
@@ -31,34 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 
 const mpi::Comm world = mpi::Comm::world();
-
-// A directory of rank 0's making, the same path on every rank, removed at the end.
-class SharedDir {
-public:
-    SharedDir()
-    {
-        std::string p;
-        if (world.is_root()) {
-            std::string templ = (fs::temp_directory_path() / "superball-runs-XXXXXX").string();
-            p = mkdtemp(templ.data()) ? templ : "";
-        }
-        world.broadcast(p);
-        if (p.empty()) throw std::runtime_error("mkdtemp failed");
-        path_ = p;
-    }
-    ~SharedDir()
-    {
-        world.barrier();
-        std::error_code ec;
-        if (world.is_root()) fs::remove_all(path_, ec);
-    }
-    SharedDir(const SharedDir&) = delete;
-    SharedDir& operator=(const SharedDir&) = delete;
-    fs::path operator/(const std::string& name) const { return path_ / name; }
-
-private:
-    fs::path path_;
-};
 
 using namespace test_support;  // job_of, direct, read_result, Data, Tally, never (explore_fixture.hpp)
 
@@ -73,103 +46,6 @@ ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrit
     s.overwrite = overwrite;
     s.kernel = kernel;
     return s;
-}
-
-TEST(RunExplore, EqualsTheKernelPointByPointAtAnyRankCount)
-{
-    const SharedDir dir;
-    const Job job = job_of();
-    Tally tally;
-    const RunSummary r = run_explore(job, settings(dir / "r.h5"), world, tally, never);
-    EXPECT_TRUE(r.complete);
-    EXPECT_FALSE(r.interrupted);
-    EXPECT_EQ(r.points_this_run, job.points());
-    EXPECT_EQ(r.ranks, world.size());
-    std::uint64_t histogram = 0;
-    for (const std::uint64_t n : r.outcomes) histogram += n;
-    EXPECT_EQ(histogram, job.points());
-    if (world.is_root()) {
-        EXPECT_EQ(tally.starts, 1);
-        EXPECT_EQ(tally.computes, 1);
-        EXPECT_EQ(tally.finishes, 1);
-        EXPECT_EQ(tally.tiles, tally.start.tiles);  // every tile once
-        EXPECT_EQ(tally.points, job.points());
-        const Data got = read_result(dir / "r.h5");
-        const Data want = direct(job);
-        EXPECT_EQ(got.counts, want.counts);
-        EXPECT_EQ(got.outcomes, want.outcomes);
-        EXPECT_FALSE(fs::exists(layout::partial_path(dir / "r.h5")));
-        EXPECT_TRUE(fs::exists(dir / "r.xmf"));
-    }
-}
-
-TEST(RunExplore, StoppedRunKeepsOnlyItsPartialFileAndResumesToTheSameResult)
-{
-    const SharedDir dir;
-    // Tiles of 16 points: about 180 of them; the journal at every report.
-    const Job job = job_of("tile_points = 16\ncheckpoint_seconds = 0.01");
-    const fs::path out = dir / "stopped.h5";
-    // Rank 0 asks for a stop the tenth of the tiles' count time it is asked (it is asked
-    // between its tiles, and its first block is larger than that at up to 4 ranks: it has
-    // computed tiles by then). Not from the tiles reported: a lone rank reports every
-    // second, long after this job is done.
-    Tally tally;
-    std::uint64_t polls = 0;
-    const StopRequested stop = [&] {
-        return world.is_root() && tally.start.tiles > 0 && ++polls > tally.start.tiles / 10;
-    };
-    ExploreSettings first_settings = settings(out);
-    first_settings.command = "first run";
-    const RunSummary first = run_explore(job, first_settings, world, tally, stop);
-    EXPECT_TRUE(first.interrupted);
-    EXPECT_FALSE(first.complete);
-    if (world.is_root()) {
-        EXPECT_FALSE(fs::exists(out));
-        ASSERT_TRUE(fs::exists(layout::partial_path(out)));
-        const ResultReader partial(layout::partial_path(out));
-        EXPECT_EQ(partial.info().kind, FileKind::partial);
-        // Provenance: the run that made the file, recorded once although it wrote its
-        // figures at the start and at the stop.
-        EXPECT_EQ(partial.info().history.rfind(partial.info().date_created + " first run [", 0), 0u) << partial.info().history;
-        EXPECT_EQ(partial.info().history.find('\n'), std::string::npos) << partial.info().history;
-        EXPECT_EQ(partial.info().source, software_source());
-        EXPECT_EQ(partial.info().mpi_ranks, world.size());
-        EXPECT_GE(partial.info().mpi_hosts, 1);
-        EXPECT_EQ(partial.info().threads, 1);
-        EXPECT_GT(partial.info().tiles_done, 0u);
-        EXPECT_LT(partial.info().tiles_done, partial.info().tiles);
-        EXPECT_TRUE(partial.damaged_tiles().empty());
-    }
-    // Without --resume the interrupted run is refused, on every rank alike.
-    Tally refused;
-    EXPECT_THROW(run_explore(job, settings(out), world, refused, never), InputError);
-    Tally again;
-    ExploreSettings resumed = settings(out, true, false, scalar_kernel().count);
-    resumed.command = "second run";
-    const RunSummary second = run_explore(job, resumed, world, again, never);
-    EXPECT_TRUE(second.complete);
-    EXPECT_LT(second.points_this_run, job.points());  // only the tiles not done
-    if (world.is_root()) {
-        // The resume's line follows the first run's; date_created stays the first run's.
-        const ResultInfo info = ResultReader(out).info();
-        const std::size_t newline = info.history.find('\n');
-        ASSERT_NE(newline, std::string::npos) << info.history;
-        EXPECT_EQ(info.history.rfind(info.date_created + " first run [", 0), 0u) << info.history;
-        EXPECT_NE(info.history.find(" second run [", newline), std::string::npos) << info.history;
-        EXPECT_NE(info.history.find("kernel scalar]", newline), std::string::npos) << info.history;
-        EXPECT_EQ(info.history.find('\n', newline + 1), std::string::npos) << info.history;
-        EXPECT_GT(again.start.tiles_done, 0u);
-        EXPECT_EQ(again.start.tiles_done + again.tiles, again.start.tiles);
-        const Data got = read_result(out);
-        const Data want = direct(job);
-        EXPECT_EQ(got.counts, want.counts);
-        EXPECT_EQ(got.outcomes, want.outcomes);
-        EXPECT_FALSE(fs::exists(layout::partial_path(out)));
-    }
-    // Complete: --resume has nothing to do.
-    Tally nothing;
-    const RunSummary third = run_explore(job, settings(out, true, false), world, nothing, never);
-    EXPECT_TRUE(third.nothing_to_do);
 }
 
 // Runs `job` with `s` (not resuming), stopped by rank 0 once tiles are recorded or when it
@@ -407,11 +283,11 @@ TEST(RunExplore, PlansRefuseAlikeOnEveryRank)
     Tally tally;
     run_explore(job, settings(out), world, tally, never);
     // An existing result without --overwrite or --resume; another job's result with --resume.
-    EXPECT_THROW(plan_explore(job, settings(out), world), InputError);
+    EXPECT_THROW(plan_explore(job, settings(out), Team::ranks(world)), InputError);
     const Job other = job_of("tile_points = 64", 999);
-    EXPECT_THROW(plan_explore(other, settings(out, true, false), world), InputError);
-    EXPECT_EQ(plan_explore(job, settings(out, false, true), world).mode, PlanMode::fresh);
-    EXPECT_EQ(plan_explore(job, settings(out, true, false), world).mode, PlanMode::complete);
+    EXPECT_THROW(plan_explore(other, settings(out, true, false), Team::ranks(world)), InputError);
+    EXPECT_EQ(plan_explore(job, settings(out, false, true), Team::ranks(world)).mode, PlanMode::fresh);
+    EXPECT_EQ(plan_explore(job, settings(out, true, false), Team::ranks(world)).mode, PlanMode::complete);
     // Not superball's: refused even with --overwrite, and left as it was.
     const fs::path text = dir / "thesis.tex";
     if (world.is_root()) {
@@ -421,7 +297,7 @@ TEST(RunExplore, PlansRefuseAlikeOnEveryRank)
         std::fclose(f);
     }
     world.barrier();
-    EXPECT_THROW(plan_explore(job, settings(text, false, true), world), InputError);
+    EXPECT_THROW(plan_explore(job, settings(text, false, true), Team::ranks(world)), InputError);
     if (world.is_root()) {
         EXPECT_EQ(fs::file_size(text), 24u);
     }

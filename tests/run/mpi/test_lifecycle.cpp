@@ -1,0 +1,50 @@
+// The lifecycle suite (tests/run/lifecycle_suite.hpp) over a team of MPI ranks (run_explore
+// on every rank of the test's mpirun, 1 to 4) and over a team of threads in each rank (each
+// rank its own run in its own directory, as a Python user's process under mpirun would).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "mpi/mpi.hpp"
+#include "run/explore.hpp"
+#include "run/explore_threads.hpp"
+#include "../../temp_dir.hpp"
+#include "../lifecycle_suite.hpp"
+#include "shared_dir.hpp"
+
+namespace superball::test_support {
+namespace {
+
+struct OnRanks {
+    SharedDir dir;
+    std::filesystem::path operator/(const std::string& name) const { return dir / name; }
+    RunSummary run(const Job& job, const ExploreSettings& s, RunObserver& observer, const StopRequested& stop, unsigned)
+    {
+        return run_explore(job, s, mpi::Comm::world(), observer, stop);
+    }
+    bool root() const { return mpi::Comm::world().is_root(); }
+    void sync() const { mpi::Comm::world().barrier(); }
+    int ranks() const { return mpi::Comm::world().size(); }
+    int threads(unsigned) const { return 1; }
+};
+
+struct OnThreadsOfEachRank {
+    TempDir dir{"superball-lifecycle"};
+    std::filesystem::path operator/(const std::string& name) const { return dir / name; }
+    RunSummary run(const Job& job, const ExploreSettings& s, RunObserver& observer, const StopRequested& stop,
+                   unsigned threads)
+    {
+        return run_explore_threads(job, s, threads, observer, stop);
+    }
+    bool root() const { return true; }
+    void sync() const {}
+    int ranks() const { return 1; }
+    int threads(unsigned asked) const { return static_cast<int>(asked); }
+};
+
+using Teams = testing::Types<OnRanks, OnThreadsOfEachRank>;
+INSTANTIATE_TYPED_TEST_SUITE_P(Team, Lifecycle, Teams);
+
+}  // namespace
+}  // namespace superball::test_support
