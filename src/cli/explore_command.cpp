@@ -106,15 +106,23 @@ void print_plan(const Job& job, const DryRun& d, int ranks)
         fmt::print("plan: refused: {}\n", d.refusal);
     }
     // For batch scripts deciding between a new run and --resume: the result, or the partial
-    // file of an interrupted run.
-    fmt::print("output: {}\noutput exists: {}\n", d.output.string(), d.exists ? "yes" : "no");
-    if (!d.exists) return;
-    fmt::print("partial file: {}\n", d.has_partial ? d.partial.string() : "none");
-    if (d.existing) {
-        fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n", d.existing->complete ? "yes" : "no",
-                   d.existing->tiles_done, d.existing->tiles, d.existing->same_job ? "yes" : "no");
-    } else {
-        fmt::print("output complete: unreadable (not a superball result)\n");
+    // file of an interrupted run; then the other files a run writes, when something is there.
+    const FilesThere& f = d.files;
+    const bool exists = f.output.exists || f.partial.exists;
+    fmt::print("output: {}\noutput exists: {}\n", f.output.path.string(), exists ? "yes" : "no");
+    if (exists) {
+        fmt::print("partial file: {}\n", f.partial.exists ? f.partial.path.string() : "none");
+        const FoundFile& there = f.partial.exists ? f.partial : f.output;
+        if (there.info) {
+            fmt::print("output complete: {} ({} of {} tiles done)\noutput same job: {}\n",
+                       there.info->kind == FileKind::result ? "yes" : "no", there.info->tiles_done, there.info->tiles,
+                       there.info->job_fingerprint == fingerprint(job) ? "yes" : "no");
+        } else {
+            fmt::print("output complete: unreadable (not a superball result)\n");
+        }
+    }
+    for (const auto& [name, c] : {std::pair{"undo log", &f.undo_log}, std::pair{"sidecar", &f.sidecar}}) {
+        if (c->exists) fmt::print("{}: {} ({})\n", name, c->path.string(), c->ours ? "superball's" : c->identity.description);
     }
 }
 

@@ -26,6 +26,7 @@
 #include "job/grid.hpp"
 #include "job/provenance.hpp"
 #include "run/explore_work.hpp"
+#include "run/files_there.hpp"
 #include "run/lifecycle.hpp"
 #include "run/refine.hpp"
 #include "run/tile_counter.hpp"
@@ -57,23 +58,19 @@ Decision refuse_foreign(const ExploreSettings& s, const fs::path& path, const Fi
 }
 
 // Rank 0: what to do with an existing partial file (a run in progress or interrupted).
-Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const Job& job)
+Decision decide_partial(const ExploreSettings& s, const FoundFile& found, const Job& job)
 {
-    std::optional<ResultReader> reader;
-    std::string problem;
-    try {
-        reader.emplace(partial);
-        if (reader->info().kind != FileKind::partial) problem = partial.string() + " is a complete result, not a partial file";
-    } catch (const InputError& e) {
-        problem = e.what();
-    }
+    const fs::path& partial = found.path;
+    std::string problem = found.problem;
+    if (found.info && found.info->kind != FileKind::partial) problem = partial.string() + " is a complete result, not a partial file";
     if (!problem.empty()) {
-        const FileIdentity id = identify_file(partial);
-        if (!id.superball) return refuse_foreign(s, partial, id, " (where this output's run keeps its tiles)");
+        if (!found.info && !found.identity.superball) {
+            return refuse_foreign(s, partial, found.identity, " (where this output's run keeps its tiles)");
+        }
         if (s.overwrite) return {Verdict::fresh, "replacing " + partial.string() + ", which cannot be resumed (--overwrite)"};
         return refuse(problem + "; it is left as it is: --overwrite to start the run again, or --output to write elsewhere");
     }
-    const ResultInfo& info = reader->info();
+    const ResultInfo& info = *found.info;
     if (s.overwrite) {
         return {Verdict::fresh, fmt::format("replacing the interrupted run in {} ({} of {} tiles done; --overwrite)",
                                             partial.string(), info.tiles_done, info.tiles)};
@@ -108,67 +105,43 @@ Decision decide_partial(const ExploreSettings& s, const fs::path& partial, const
 }
 
 // Rank 0: what to do with an existing output and no partial file.
-Decision decide_output(const ExploreSettings& s, const fs::path& out, const Job& job)
+Decision decide_output(const ExploreSettings& s, const FoundFile& found, const Job& job)
 {
-    try {
-        const ResultReader reader(out);
-        const ResultInfo& info = reader.info();
-        if (info.kind != FileKind::result) {
-            if (s.overwrite) return {Verdict::fresh, "replacing " + out.string() + ", the partial file of a run (--overwrite)"};
-            return refuse(fmt::format("{} holds the partial file of a run ({} of {} tiles done), not a result; --overwrite "
-                                      "to replace it, or --output to write elsewhere",
-                                      out.string(), info.tiles_done, info.tiles));
-        }
-        if (s.overwrite) {
-            return {Verdict::fresh, "replacing " + out.string() + " when the new run completes (--overwrite)"};
-        }
-        if (!s.resume) {
-            return refuse(out.string() + " already holds a complete result; use --overwrite to replace it or --output to "
-                                         "write elsewhere");
-        }
-        if (info.job_fingerprint != fingerprint(job)) {
-            return refuse(out.string() + " holds the result of a different job (grid, model or max_bounces differ): use "
-                                         "another --output, or --overwrite");
-        }
-        return {Verdict::complete, out.string() + " is already complete: nothing to do"};
-    } catch (const InputError& e) {
-        const FileIdentity id = identify_file(out);
-        if (!id.superball) return refuse_foreign(s, out, id, "");
+    const fs::path& out = found.path;
+    if (!found.info) {
+        if (!found.identity.superball) return refuse_foreign(s, out, found.identity, "");
         if (s.overwrite) return {Verdict::fresh, "replacing the damaged " + out.string() + " (--overwrite)"};
-        return refuse(std::string(e.what()) + "; --overwrite to replace it, or --output to write elsewhere");
+        return refuse(found.problem + "; --overwrite to replace it, or --output to write elsewhere");
     }
-}
-
-// Whether `path` is an XDMF sidecar as superball writes them (io/xdmf.cpp): XML naming a
-// result's /wall_bounces. A sidecar is small; the first 64 KiB say.
-bool is_superball_sidecar(const fs::path& path)
-{
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) return false;
-    std::ifstream in(path, std::ios::binary);
-    std::string head(std::size_t{64} * 1024, '\0');
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    return head.rfind("<?xml", 0) == 0 && head.find("<Xdmf") != std::string::npos &&
-           head.find(":/wall_bounces</DataItem>") != std::string::npos;
+    const ResultInfo& info = *found.info;
+    if (info.kind != FileKind::result) {
+        if (s.overwrite) return {Verdict::fresh, "replacing " + out.string() + ", the partial file of a run (--overwrite)"};
+        return refuse(fmt::format("{} holds the partial file of a run ({} of {} tiles done), not a result; --overwrite "
+                                  "to replace it, or --output to write elsewhere",
+                                  out.string(), info.tiles_done, info.tiles));
+    }
+    if (s.overwrite) return {Verdict::fresh, "replacing " + out.string() + " when the new run completes (--overwrite)"};
+    if (!s.resume) {
+        return refuse(out.string() + " already holds a complete result; use --overwrite to replace it or --output to "
+                                     "write elsewhere");
+    }
+    if (info.job_fingerprint != fingerprint(job)) {
+        return refuse(out.string() + " holds the result of a different job (grid, model or max_bounces differ): use "
+                                     "another --output, or --overwrite");
+    }
+    return {Verdict::complete, out.string() + " is already complete: nothing to do"};
 }
 
 // Rank 0: the other files a run writes, the sidecar OUTPUT.xmf and the undo log
 // OUTPUT.partial.undo (io/placed_chunks.hpp), are replaced only if they are superball's too.
-std::optional<Decision> check_companions(const ExploreSettings& s, const fs::path& out)
+std::optional<Decision> check_companions(const ExploreSettings& s, const FilesThere& files)
 {
-    const fs::path sidecar = layout::sidecar_path(out);
-    std::error_code ec;
-    const fs::path undo = PlacedChunks::undo_path(layout::partial_path(out));
-    if ((fs::exists(undo, ec) || fs::is_symlink(undo, ec)) && !PlacedChunks::is_undo_log(undo)) {
-        return refuse_foreign(s, undo, identify_file(undo), " (where the run keeps the undo log of its partial file's changes)");
+    if (files.undo_log.exists && !files.undo_log.ours) {
+        return refuse_foreign(s, files.undo_log.path, files.undo_log.identity,
+                              " (where the run keeps the undo log of its partial file's changes)");
     }
-    // A result named *.xmf, or with a colon in its name, gets no sidecar (xdmf_unsupported).
-    const bool gets_sidecar = sidecar != out && out.filename().string().find(':') == std::string::npos;
-    if (gets_sidecar && (fs::exists(sidecar, ec) || fs::is_symlink(sidecar, ec))) {
-        if (!is_superball_sidecar(sidecar)) {
-            return refuse_foreign(s, sidecar, identify_file(sidecar), " (where the result's ParaView sidecar goes)");
-        }
+    if (files.gets_sidecar && files.sidecar.exists && !files.sidecar.ours) {
+        return refuse_foreign(s, files.sidecar.path, files.sidecar.identity, " (where the result's ParaView sidecar goes)");
     }
     return std::nullopt;
 }
@@ -176,11 +149,14 @@ std::optional<Decision> check_companions(const ExploreSettings& s, const fs::pat
 // Rank 0, for a fresh run, before anything is written: the output's directory exists
 // (created if need be) and files can be made there. A path that cannot be written is
 // refused like bad input (status 2, one message) instead of failing later on every rank.
+Decision cannot_write(const fs::path& out, const std::string& why)
+{
+    return refuse("cannot write the result " + out.string() + ": " + why + "; choose another --output (or [run] output)");
+}
+
 Decision check_writable(const fs::path& out, Decision d)
 {
-    const auto cannot = [&](const std::string& why) {
-        return refuse("cannot write the result " + out.string() + ": " + why + "; choose another --output (or [run] output)");
-    };
+    const auto cannot = [&](const std::string& why) { return cannot_write(out, why); };
     std::error_code ec;
     if (out.has_parent_path()) {
         fs::create_directories(out.parent_path(), ec);
@@ -196,28 +172,50 @@ Decision check_writable(const fs::path& out, Decision d)
     return d;
 }
 
-Decision decide(const ExploreSettings& s, const fs::path& out, const Job& job)
+// check_writable for --dry-run, which makes nothing: the nearest directory that exists on
+// the output's path must let this process make files in it.
+Decision check_writable_as_is(const fs::path& out, Decision d)
 {
-    if (std::optional<Decision> d = check_companions(s, out)) return *d;
     std::error_code ec;
-    const fs::path partial = layout::partial_path(out);
-    if (fs::exists(partial, ec) || fs::is_symlink(partial, ec)) {
-        // A run stopped while its partial file was being made the result: the file as it
-        // was before, first (io/placed_chunks.hpp).
-        std::string undone;
-        if (fs::is_regular_file(partial, ec) && PlacedChunks::undo_interrupted_changes(partial)) {
-            undone = "the run before stopped while finishing " + partial.string() + ": its changes were undone; ";
-        }
-        Decision d = decide_partial(s, partial, job);
-        d.message = undone + d.message;
-        return d.verdict == Verdict::fresh ? check_writable(out, std::move(d)) : d;
+    if (fs::is_directory(out, ec)) return cannot_write(out, "it is a directory");
+    fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
+    while (!fs::exists(dir, ec) && dir.has_parent_path() && dir.parent_path() != dir) dir = dir.parent_path();
+    if (!fs::is_directory(dir, ec)) return cannot_write(out, dir.string() + " is not a directory");
+    if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+        return cannot_write(out, "cannot make files in " + dir.string() + " (" +
+                                     std::error_code(errno, std::generic_category()).message() + ")");
     }
-    PlacedChunks::discard_undo(partial);  // a log left by a run that finished: nothing to undo
-    if (fs::exists(out, ec) || fs::is_symlink(out, ec)) {
-        Decision d = decide_output(s, out, job);
-        return d.verdict == Verdict::fresh ? check_writable(out, std::move(d)) : d;
+    return d;
+}
+
+// What to do, from the files there alone: nothing is changed.
+Decision decide(const ExploreSettings& s, const FilesThere& files, const Job& job)
+{
+    if (std::optional<Decision> d = check_companions(s, files)) return *d;
+    if (files.partial.exists) return decide_partial(s, files.partial, job);
+    if (files.output.exists) return decide_output(s, files.output, job);
+    return {Verdict::fresh, s.resume ? "no run to resume at " + files.output.path.string() + ": starting a new run" : ""};
+}
+
+// Rank 0, before a run: the files there looked at, the undo log (superball's: another file
+// there is refused by decide) of a run that stopped while finishing applied first (its partial file as it was before: io/placed_chunks.hpp) and that
+// of a run that finished discarded, the decision made, and a fresh run's output checked
+// writable.
+Decision prepare(const ExploreSettings& s, const fs::path& out, const Job& job)
+{
+    FilesThere files = look_at_files(out);
+    std::string undone;
+    std::error_code ec;
+    if (!files.partial.exists) {
+        if (files.undo_log.ours) PlacedChunks::discard_undo(files.partial.path);
+    } else if (files.undo_log.ours && fs::is_regular_file(files.partial.path, ec) &&
+               PlacedChunks::undo_interrupted_changes(files.partial.path)) {
+        undone = "the run before stopped while finishing " + files.partial.path.string() + ": its changes were undone; ";
+        files.partial = look_at(files.partial.path);
     }
-    return check_writable(out, {Verdict::fresh, s.resume ? "no run to resume at " + out.string() + ": starting a new run" : ""});
+    Decision d = decide(s, files, job);
+    d.message = undone + d.message;
+    return d.verdict == Verdict::fresh ? check_writable(out, std::move(d)) : d;
 }
 
 }  // namespace
@@ -565,11 +563,11 @@ void Recorder::recorded(std::span<const AppendedTile> tiles)
 
 namespace {
 
-// decide(), which never throws: whatever goes wrong, every rank must hear the verdict.
+// prepare(), which never throws: whatever goes wrong, every rank must hear the verdict.
 Decision decide_or_refuse(const ExploreSettings& settings, const fs::path& out, const Job& job)
 {
     try {
-        return decide(settings, out, job);
+        return prepare(settings, out, job);
     } catch (const std::exception& e) {
         return refuse("cannot decide what to do with " + out.string() + ": " + e.what());
     }
@@ -667,25 +665,17 @@ Counted count_on_ranks(OpenRun& run, std::vector<ListedTile> pending, const Expl
 DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks)
 {
     const fs::path out = output_path(job, settings);
-    DryRun d{std::nullopt, {}, out, layout::partial_path(out), default_tiling(job, ranks), false, false, std::nullopt,
-             settings.writers.value_or(job.writers)};
-    const Decision decision = decide_or_refuse(settings, out, job);
+    DryRun d{std::nullopt, {}, look_at_files(out), default_tiling(job, ranks), settings.writers.value_or(job.writers)};
+    Decision decision = decide(settings, d.files, job);
+    if (d.files.partial.exists && d.files.undo_log.ours) {
+        decision.message = "the run before stopped while finishing " + d.files.partial.path.string() +
+                           ": a run undoes its changes first, then decides again; " + decision.message;
+    }
+    if (decision.verdict == Verdict::fresh) decision = check_writable_as_is(out, std::move(decision));
     if (decision.verdict == Verdict::refuse) {
         d.refusal = decision.message;
     } else {
         d.plan = plan_of(decision, out);
-    }
-    std::error_code ec;
-    d.has_partial = fs::exists(d.partial, ec);
-    d.exists = d.has_partial || fs::exists(out, ec);
-    if (!d.exists) return d;
-    try {
-        const ResultReader reader(d.has_partial ? d.partial : out);
-        const ResultInfo& info = reader.info();
-        d.existing = DryRun::Existing{info.kind == FileKind::result, info.tiles_done, info.tiles,
-                                      info.job_fingerprint == fingerprint(job)};
-    } catch (const std::exception&) {
-        // Not a superball file, or damaged: existing stays empty.
     }
     return d;
 }

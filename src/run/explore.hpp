@@ -25,6 +25,7 @@
 #include "job/tiles.hpp"
 #include "mpi/mpi.hpp"
 #include "run/progress.hpp"
+#include "run/files_there.hpp"
 #include "run/schedule.hpp"
 #include "run/team.hpp"
 
@@ -73,25 +74,17 @@ struct ExplorePlan {
 // belongs to another job or version, or it cannot be written.
 ExplorePlan plan_explore(const Job& job, const ExploreSettings& settings, const Team& team);
 
-// What `superball explore --dry-run` shows: the run planned for `ranks` ranks, without
-// running it or touching a file. `plan`/`refusal`: plan_explore's decision; the rest, the
-// output as it stands, for batch scripts choosing between a new run and --resume.
+// What `superball explore --dry-run` shows: the run planned for `ranks` ranks, decided from
+// the files there (run/files_there.hpp) without running it or changing a file: a pending
+// undo log is not applied (the note says the run would apply it first), no directory is made.
+// `plan`/`refusal`: plan_explore's decision; `files`: what is there, for batch scripts
+// choosing between a new run and --resume.
 struct DryRun {
     std::optional<ExplorePlan> plan;  // none: refused, for the reason in `refusal`
     std::string refusal;
-    std::filesystem::path output;
-    std::filesystem::path partial;  // OUTPUT.partial
+    FilesThere files;
     Tiling tiling;
-    bool exists = false;       // the output or its partial file
-    bool has_partial = false;
-    struct Existing {
-        bool complete = false;  // a result (else a partial file)
-        std::uint64_t tiles_done = 0;
-        std::uint64_t tiles = 0;
-        bool same_job = false;
-    };
-    std::optional<Existing> existing;  // when it exists and reads as a superball file
-    std::uint32_t writers = 0;         // asked for (0: auto)
+    std::uint32_t writers = 0;  // asked for (0: auto)
 };
 DryRun dry_run_explore(const Job& job, const ExploreSettings& settings, int ranks);
 
