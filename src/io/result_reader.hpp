@@ -1,5 +1,7 @@
 // The one reader of superball's files (io/layout.hpp), results and partial files alike,
-// used by `info`, `analyse`, the resume decision and the viewer. Results are shared
+// used by `info`, `analyse`, the resume decision and the viewer. Its three concerns, a file
+// each: what is at a path (io/file_identity.hpp), the schema checked at open
+// (io/result_schema.cpp), the values checked as they are read (io/result_reader.cpp). Results are shared
 // between users and files get damaged: the reader trusts nothing. Opening validates the
 // structure (objects, types, shapes, attributes and their agreement); reading validates
 // the values (outcome codes, counts against max_bounces, the checksums of a partial
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "core/input.hpp"
+#include "file_identity.hpp"
 #include "hdf5_id.hpp"
 #include "job/tiles.hpp"
 #include "posix_file.hpp"
@@ -144,19 +147,5 @@ private:
 // Calls f with boxes covering a grid of `shape` once, each of at most `max_points` points
 // (one point at least), in storage order: whole trailing axes where they fit.
 void for_each_block(const Extent& shape, std::uint64_t max_points, const std::function<void(const Box&)>& f);
-
-// What is at `path`, for messages and for the writer's decision to replace it.
-struct FileIdentity {
-    // A superball file (result or partial, any version), readable or not: one that
-    // `explore --overwrite` may replace.
-    bool superball = false;
-    // "a directory", "a text file of 120 bytes, beginning ...", "a superball file", "a
-    // damaged superball file (...)", "an HDF5 file that is not superball's", ...
-    std::string description;
-};
-FileIdentity identify_file(const std::filesystem::path& path);
-
-// identify_file(path).description.
-std::string describe_file(const std::filesystem::path& path);
 
 }  // namespace superball
