@@ -38,6 +38,7 @@
 #include <unistd.h>
 
 #include <simgrid/s4u/Actor.hpp>
+#include <simgrid/s4u/Barrier.hpp>
 #include <simgrid/s4u/Comm.hpp>
 #include <simgrid/s4u/ConditionVariable.hpp>
 #include <simgrid/s4u/Disk.hpp>
@@ -51,6 +52,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <cstring>
 #include <deque>
 #include <mutex>
@@ -785,12 +787,48 @@ struct Memory {
     double total() const { return list + resume + journal + buffers; }
 };
 
+// The model's own meetings of every rank (the program's collectives stay real: run_schedule's
+// and the topology's): a SimGrid barrier, which simulates no message, then what a tree
+// collective costs the real program, 2 log2(P) link latencies (1 us, cluster.xml). SMPI's
+// collectives at 16384 ranks kept the simulator several minutes each (thousands of flows
+// at once on shared links, the network model solved again as each ends): the dozen at the
+// start and end of a run took longer than its counting. Values the ranks give to be
+// reduced go through memory: SMPI runs the ranks in one process (smpi/privatization:no).
+class Meeting {
+public:
+    explicit Meeting(int ranks) : ranks_(ranks), barrier_(shared(ranks)) {}
+    void meet() const
+    {
+        barrier_->wait();
+        simgrid::s4u::this_actor::sleep_for(2 * std::ceil(std::log2(std::max(2, ranks_))) * 1e-6);
+    }
+    // Every rank's `mine` (the same length on every rank), after a meeting: rank r's at [r].
+    const std::vector<std::vector<double>>& gather(int rank, std::vector<double> mine) const
+    {
+        static std::vector<std::vector<double>> board;
+        if (board.size() != static_cast<std::size_t>(ranks_)) board.resize(static_cast<std::size_t>(ranks_));
+        board[static_cast<std::size_t>(rank)] = std::move(mine);
+        meet();
+        return board;
+    }
+
+private:
+    static simgrid::s4u::BarrierPtr shared(int ranks)
+    {
+        static const simgrid::s4u::BarrierPtr b = simgrid::s4u::Barrier::create(static_cast<unsigned>(ranks));
+        return b;
+    }
+    int ranks_;
+    simgrid::s4u::BarrierPtr barrier_;
+};
+
 int run(int argc, char** argv)
 {
     const Options o = parse(argc, argv);
     const mpi::Comm world = mpi::Comm::world();
     const int rank = world.rank();
     const int ranks = world.size();
+    const Meeting meeting(ranks);
     // One mapping for the whole simulation: SMPI runs every rank as a thread of this
     // process (smpi/privatization:no, so this static is shared), one after the other.
     static const Costs costs(o.costs);
@@ -800,7 +838,7 @@ int run(int argc, char** argv)
     FileSystem fs(o, rank);
     ModelWork work(costs, fs, o, rank);
     if (rank == 0) busy_by_rank.assign(static_cast<std::size_t>(ranks), 0.0);
-    world.barrier();
+    meeting.meet();
     work.shared_busy = &busy_by_rank[static_cast<std::size_t>(rank)];
     const double tiles = static_cast<double>(costs.tiles());
     const double pending = static_cast<double>(costs.pending().size());
@@ -839,7 +877,7 @@ int run(int argc, char** argv)
             fs.client_write(bytes, 0, o.create_writes);
             fs.metadata();
         }
-        world.barrier();
+        meeting.meet();
     } else {
         static std::vector<std::uint64_t> done;  // the done tiles, in order: rank 0's list, every rank's copy
         if (rank == 0) {
@@ -854,7 +892,7 @@ int run(int argc, char** argv)
                 if (!pend[t]) done.push_back(t);
             }
         }
-        world.barrier();
+        meeting.meet();
         const double levels = std::ceil(std::log2(std::max(2, ranks)));
         const double bcast = levels * 2e-6 + 2 * (tiles / 8) / 12.5e9;
         const double scatter = ranks * 2e-6 + (o.compressed ? 32 : 8) * done_tiles / 12.5e9;
@@ -872,7 +910,7 @@ int run(int argc, char** argv)
             fs.client_read(bytes, static_cast<double>(end - begin));
             smpi_execute(bytes / (o.hash_gbps * 1e9));
         }
-        world.barrier();
+        meeting.meet();
         restart_s = MPI_Wtime() - t0;
     }
 
@@ -886,7 +924,7 @@ int run(int argc, char** argv)
     if (o.compressed && writer_count > 1 && rank != 0) writing.sink = &sink.emplace(fs, costs, o);
     const bool opens = !o.compressed || rank == 0;  // the sinks' writers open the file at their first write, below
     if (opens && !(o.resumed && rank != 0)) fs.metadata();
-    world.barrier();
+    meeting.meet();
 
     // Rank 0: the appender of compressed tiles; the tiles it records write their places and
     // checksums into the journal (Journal::record: each run of consecutive tiles of a batch
@@ -991,7 +1029,7 @@ int run(int argc, char** argv)
             return f;
         };
     }
-    world.barrier();
+    meeting.meet();
     const double start = MPI_Wtime();
     work.last_end = start;
     work.bucket = o.trace_bucket;
@@ -1024,7 +1062,8 @@ int run(int argc, char** argv)
         })->daemonize();
     }
     const ScheduleResult r = run_schedule(world, costs.listed(), work, done, [] { return false; }, o.schedule, writing);
-    const double scheduled = world.max(MPI_Wtime());
+    double scheduled = 0;
+    for (const std::vector<double>& t : meeting.gather(rank, {MPI_Wtime()})) scheduled = std::max(scheduled, t[0]);
     if (o.trace) {
         // Every rank's time between tiles, summed by second of the run: where the waits are.
         const auto seconds = static_cast<std::size_t>(world.max(static_cast<double>(work.gaps.size())));
@@ -1055,7 +1094,7 @@ int run(int argc, char** argv)
         checkpoint(false);
         finish_start = MPI_Wtime();
     }
-    world.barrier();
+    meeting.meet();
     if (rank == 0 && o.io) {
         fs.metadata();           // the undo log
         fs.metadata();           // the HDF5 open
@@ -1074,7 +1113,7 @@ int run(int argc, char** argv)
         fs.client_write(1024);
         fs.metadata();
     }
-    world.barrier();
+    meeting.meet();
     const double end = MPI_Wtime();
     const double written = appender ? appender->written_bytes : 0.0;
     const double writes = appender ? static_cast<double>(appender->writes) : 0.0;
@@ -1099,27 +1138,36 @@ int run(int argc, char** argv)
     if (sink_wrote) mem.buffers += std::max(sink->peak_bytes, 2 * o.append_bytes) + message;
     if (r.stats.leader && rank != 0 && !r.stats.writer && o.compressed) mem.buffers += 2 * message;
 
-    // Reductions, not a gather: SMPI's gather to one rank of 4096 waits on its requests one
-    // by one (minutes of wall time).
-    const auto reduce = [&](std::vector<double> v, MPI_Op op) {
-        mpi::check(MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_DOUBLE, op, world.get()),
-                   "MPI_Allreduce");
+    // Every rank's figures reduced (Meeting::gather: in memory, not SMPI's collectives).
+    const auto reduce = [&](const std::vector<std::vector<double>>& all, std::size_t at, std::size_t n, auto op) {
+        std::vector<double> v(all[0].begin() + static_cast<std::ptrdiff_t>(at), all[0].begin() + static_cast<std::ptrdiff_t>(at + n));
+        for (const std::vector<double>& r : all) {
+            for (std::size_t k = 0; k < n; ++k) v[k] = op(v[k], r[at + k]);
+        }
         return v;
     };
     const double last = work.last_end;
     const double tiles_here = static_cast<double>(r.stats.tiles);
-    const std::vector<double> mins = reduce({r.stats.computed ? last : 1e300, r.stats.computed ? tiles_here : 1e300}, MPI_MIN);
-    const std::vector<double> maxs =
-        reduce({r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0, scheduled - start,
-                r.stats.computed ? tiles_here : 0.0, sink_bytes, sink_held_back, sink_peak_ingress, mem.total(),
-                rank != 0 ? mem.total() : 0.0, fs.metadata_wait, r.stats.space_wait_seconds},
-               MPI_MAX);
-    const std::vector<double> sums = reduce({static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
-                                             r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes,
-                                             r.stats.computed ? 1.0 : 0.0, static_cast<double>(fs.write_calls), fs.bytes_written,
-                                             sink_bytes, sink ? sink->copy_s : 0.0},
-                                            MPI_SUM);
-    if (rank == 0) {
+    const std::vector<double> mine_min{r.stats.computed ? last : 1e300, r.stats.computed ? tiles_here : 1e300};
+    const std::vector<double> mine_max{r.stats.computed ? last : 0.0, rank != 0 ? static_cast<double>(r.stats.messages_in) : 0.0,
+                                       scheduled - start, r.stats.computed ? tiles_here : 0.0, sink_bytes, sink_held_back,
+                                       sink_peak_ingress, mem.total(), rank != 0 ? mem.total() : 0.0, fs.metadata_wait,
+                                       r.stats.space_wait_seconds};
+    const std::vector<double> mine_sum{static_cast<double>(fs.operations), static_cast<double>(r.stats.given_back),
+                                       r.stats.computed ? r.stats.idle_seconds : 0.0, work.payload_bytes,
+                                       r.stats.computed ? 1.0 : 0.0, static_cast<double>(fs.write_calls), fs.bytes_written,
+                                       sink_bytes, sink ? sink->copy_s : 0.0};
+    std::vector<double> mine = mine_min;
+    mine.insert(mine.end(), mine_max.begin(), mine_max.end());
+    mine.insert(mine.end(), mine_sum.begin(), mine_sum.end());
+    const std::vector<std::vector<double>>& all = meeting.gather(rank, std::move(mine));
+    if (rank != 0) return 0;  // rank 0 reduces and reports
+    const auto least = [](double a, double b) { return std::min(a, b); };
+    const auto most = [](double a, double b) { return std::max(a, b); };
+    const std::vector<double> mins = reduce(all, 0, mine_min.size(), least);
+    const std::vector<double> maxs = reduce(all, mine_min.size(), mine_max.size(), most);
+    const std::vector<double> sums = reduce(all, mine_min.size() + mine_max.size(), mine_sum.size(), std::plus<>());
+    {
         double total = 0;
         for (const std::uint64_t t : costs.pending()) total += costs.cost(t);  // (every tile, unless resumed)
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
