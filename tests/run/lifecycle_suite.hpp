@@ -24,6 +24,8 @@
 #include "io/partial_file.hpp"
 #include "io/result_reader.hpp"
 #include "run/explore.hpp"
+#include "run/explore_threads.hpp"
+#include "../temp_dir.hpp"
 #include "explore_fixture.hpp"
 
 namespace superball::test_support {
@@ -37,6 +39,21 @@ inline ExploreSettings settings_for(const std::filesystem::path& out, bool resum
     s.command = "test run";
     return s;
 }
+
+// The team of threads of this process (run_explore_threads), in a directory of its own.
+struct OnThreads {
+    TempDir dir{"superball-lifecycle"};
+    std::filesystem::path operator/(const std::string& name) const { return dir / name; }
+    RunSummary run(const Job& job, const ExploreSettings& s, RunObserver& observer, const StopRequested& stop,
+                   unsigned threads)
+    {
+        return run_explore_threads(job, s, threads, observer, stop);
+    }
+    bool root() const { return true; }
+    void sync() const {}
+    int ranks() const { return 1; }
+    int threads(unsigned asked) const { return static_cast<int>(asked); }
+};
 
 template <class Runner>
 class Lifecycle : public testing::Test {

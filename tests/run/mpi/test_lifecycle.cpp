@@ -8,8 +8,6 @@
 
 #include "mpi/mpi.hpp"
 #include "run/explore.hpp"
-#include "run/explore_threads.hpp"
-#include "../../temp_dir.hpp"
 #include "../lifecycle_suite.hpp"
 #include "shared_dir.hpp"
 
@@ -29,21 +27,8 @@ struct OnRanks {
     int threads(unsigned) const { return 1; }
 };
 
-struct OnThreadsOfEachRank {
-    TempDir dir{"superball-lifecycle"};
-    std::filesystem::path operator/(const std::string& name) const { return dir / name; }
-    RunSummary run(const Job& job, const ExploreSettings& s, RunObserver& observer, const StopRequested& stop,
-                   unsigned threads)
-    {
-        return run_explore_threads(job, s, threads, observer, stop);
-    }
-    bool root() const { return true; }
-    void sync() const {}
-    int ranks() const { return 1; }
-    int threads(unsigned asked) const { return static_cast<int>(asked); }
-};
-
-using Teams = testing::Types<OnRanks, OnThreadsOfEachRank>;
+// OnThreads (lifecycle_suite.hpp): each rank its own run in its own directory.
+using Teams = testing::Types<OnRanks, OnThreads>;
 INSTANTIATE_TYPED_TEST_SUITE_P(Team, Lifecycle, Teams);
 
 }  // namespace
