@@ -25,7 +25,7 @@ command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found: run .ci/install-de
 job_sources=(src/job/job.cpp src/job/job_parse.cpp src/job/spelling.cpp src/core/input.cpp)
 # What ResultReader needs, and the writers of its templates. HDF5 itself is Debian's, not
 # instrumented: coverage guides the fuzzer through our validation, not HDF5's parser.
-result_sources=(src/io/result_reader.cpp src/io/hdf5.cpp src/io/layout.cpp src/io/partial_file.cpp src/io/posix_file.cpp src/io/page_buffer.cpp src/io/placed_chunks.cpp
+result_sources=(src/io/result_reader.cpp src/io/result_schema.cpp src/io/file_identity.cpp src/io/hdf5.cpp src/io/layout.cpp src/io/partial_file.cpp src/io/posix_file.cpp src/io/page_buffer.cpp src/io/placed_chunks.cpp
                 src/io/chunk_codec.cpp src/io/stored_tiles.cpp src/job/provenance.cpp "$out/generated/git_revision.cpp"
                 src/io/result_metadata.cpp src/mpi/mpi.cpp src/job/grid.cpp src/job/tiles.cpp src/core/count.cpp
                 src/core/boundary_planes.cpp src/core/dynamics.cpp)
