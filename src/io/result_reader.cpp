@@ -77,14 +77,20 @@ void ResultReader::load_journal() const
     sums_.resize(info_.tiles);
     h5::read_rows(h5::open_dataset(file_, layout::tile_checksum), 0, info_.tiles, sums_, layout::tile_checksum);
     if (compressed_) {
-        std::vector<std::uint64_t> words(3 * info_.tiles);
-        h5::read_rows(h5::open_dataset(file_, layout::tile_stored), 0, info_.tiles, words, layout::tile_stored);
+        // A window of rows at a time: the places are held once, not twice (24 bytes a tile).
+        const h5::Id set = h5::open_dataset(file_, layout::tile_stored);
+        constexpr std::uint64_t window = 65536;
+        std::vector<std::uint64_t> words;
         stored_.resize(info_.tiles);
-        for (std::uint64_t t = 0; t < info_.tiles; ++t) stored_[t] = {words[3 * t], words[3 * t + 1], words[3 * t + 2]};
+        for (std::uint64_t first = 0; first < info_.tiles; first += window) {
+            const std::uint64_t n = std::min(window, info_.tiles - first);
+            words.resize(3 * n);
+            h5::read_rows(set, first, n, words, layout::tile_stored);
+            for (std::uint64_t i = 0; i < n; ++i) stored_[first + i] = {words[3 * i], words[3 * i + 1], words[3 * i + 2]};
+        }
     }
     journal_loaded_ = true;
 }
-
 
 const PosixFile& ResultReader::raw() const
 {
