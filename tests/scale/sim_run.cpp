@@ -1167,7 +1167,7 @@ int run(int argc, char** argv)
     const std::vector<double> mins = reduce(all, 0, mine_min.size(), least);
     const std::vector<double> maxs = reduce(all, mine_min.size(), mine_max.size(), most);
     const std::vector<double> sums = reduce(all, mine_min.size() + mine_max.size(), mine_sum.size(), std::plus<>());
-    {
+    {  // the line rank 0 prints
         double total = 0;
         for (const std::uint64_t t : costs.pending()) total += costs.cost(t);  // (every tile, unless resumed)
         const double first_idle = mins[0], last_busy = maxs[0], leader_messages = maxs[1], schedule_s = maxs[2];
