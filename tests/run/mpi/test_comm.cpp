@@ -7,11 +7,12 @@
 #include <cstdint>
 
 #include "mpi/mpi.hpp"
+#include "shared_dir.hpp"
 
 namespace superball {
 namespace {
 
-const mpi::Comm world = mpi::Comm::world();
+using test_support::world;
 
 // Pseudo-nodes of two consecutive ranks (the last alone when the ranks are odd), each made
 // by its two ranks only: each rank learns its place and the sum over its node is its own.

@@ -31,7 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const mpi::Comm world = mpi::Comm::world();
+using test_support::world;
 
 using namespace test_support;  // job_of, direct, read_result, Data, Tally, never (explore_fixture.hpp)
 

@@ -19,11 +19,11 @@ struct OnRanks {
     std::filesystem::path operator/(const std::string& name) const { return dir / name; }
     RunSummary run(const Job& job, const ExploreSettings& s, RunObserver& observer, const StopRequested& stop, unsigned)
     {
-        return run_explore(job, s, mpi::Comm::world(), observer, stop);
+        return run_explore(job, s, world, observer, stop);
     }
-    bool root() const { return mpi::Comm::world().is_root(); }
-    void sync() const { mpi::Comm::world().barrier(); }
-    int ranks() const { return mpi::Comm::world().size(); }
+    bool root() const { return world.is_root(); }
+    void sync() const { world.barrier(); }
+    int ranks() const { return world.size(); }
     int threads(unsigned) const { return 1; }
 };
 

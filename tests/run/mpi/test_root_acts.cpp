@@ -8,11 +8,12 @@
 #include <string>
 
 #include "run/root_acts.hpp"
+#include "shared_dir.hpp"
 
 namespace superball {
 namespace {
 
-const mpi::Comm world = mpi::Comm::world();
+using test_support::world;
 
 TEST(RootActs, NothingThrownWhenRankZeroSucceeds)
 {

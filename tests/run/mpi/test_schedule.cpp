@@ -20,11 +20,12 @@
 
 #include "mpi/mpi.hpp"
 #include "run/schedule.hpp"
+#include "shared_dir.hpp"
 
 namespace superball {
 namespace {
 
-const mpi::Comm world = mpi::Comm::world();
+using test_support::world;
 
 // One clock for every rank of this machine (CLOCK_MONOTONIC), unlike MPI_Wtime.
 double seconds() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
