@@ -57,6 +57,9 @@ struct TilesLeft {
     std::uint64_t points_done = 0;  // on the root
 };
 
+// Whether tile t's done flag is set in `bits` (a bit a tile).
+bool flagged(const std::vector<std::uint64_t>& bits, std::uint64_t t) { return ((bits[t / 64] >> (t % 64)) & 1u) != 0; }
+
 // A share's record as one message: its checksums, then (compressed) where each tile lies.
 std::vector<std::uint64_t> words_of(const JournalRecord& r)
 {
@@ -82,7 +85,7 @@ std::pair<std::vector<std::uint64_t>, JournalRecord> my_share(OpenRun& run, cons
                                                               const std::vector<std::uint64_t>& bits)
 {
     const Team& team = run.team;
-    const auto is_done = [&](std::uint64_t t) { return ((bits[t / 64] >> (t % 64)) & 1u) != 0; };
+    const auto is_done = [&](std::uint64_t t) { return flagged(bits, t); };
     // Process r checks the done tiles [n r / P, n (r + 1) / P) of the n in order.
     const auto processes = static_cast<std::uint64_t>(team.processes());
     const auto share_begin = [&](std::uint64_t r) { return left.done * r / processes; };
@@ -142,7 +145,7 @@ TilesLeft tiles_left(OpenRun& run)
     // is built (50 MiB for 16 MiB of it at 2 million tiles).
     left.pending.reserve(tiling.tiles() - left.done);
     for (std::uint64_t t = 0; t < tiling.tiles(); ++t) {
-        if (((bits[t / 64] >> (t % 64)) & 1u) == 0) {
+        if (!flagged(bits, t)) {
             left.pending.push_back(static_cast<ListedTile>(t));
         } else if (team.is_root()) {
             left.points_done += tiling.box(t).points();
