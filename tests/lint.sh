@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Static analysis of src/ with its checked-in configuration: cppcheck (tests/lint/
 # cppcheck.supp: each suppression says why) and clang-tidy (.clang-tidy: each check left
-# out says why), with the compile_commands.json of build/release (configured if missing;
-# SUPERBALL_BUILD_DIR picks another build). Exits non-zero on any finding.
+# out says why), file by file, with the compile commands of build/lint (configured here, not
+# built: the builds compile their files in batches, CMake's unity build, and a batch is not
+# what a reader of one file sees; SUPERBALL_BUILD_DIR picks another build tree configured with
+# -DCMAKE_UNITY_BUILD=OFF). Exits non-zero on any finding.
 #
 #   tests/lint.sh                cppcheck (seconds) and clang-tidy with every check of .clang-tidy
 #                                (6 minutes on 2 cores)
@@ -29,21 +31,26 @@ case ${1:-} in
   "") ;;
   *) echo "lint: unknown option $1 (accepted: --quick, --no-analyzer, --ci)" >&2; exit 2 ;;
 esac
-build=${SUPERBALL_BUILD_DIR:-$root/build/release}
-if [[ ! -f $build/compile_commands.json ]]; then
-  if [[ -n ${SUPERBALL_BUILD_DIR:-} ]]; then
-    echo "lint: no $build/compile_commands.json: configure that build first" >&2
-    exit 1
-  fi
-  cmake --preset release >/dev/null
+build=${SUPERBALL_BUILD_DIR:-$root/build/lint}
+if [[ -z ${SUPERBALL_BUILD_DIR:-} ]]; then
+  # Configuring only (seconds): version.hpp, the one generated header src/ includes, is
+  # written at configure time.
+  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=OFF -DSUPERBALL_TESTS=OFF \
+    -DSUPERBALL_BENCHMARKS=OFF >/dev/null
+elif [[ ! -f $build/compile_commands.json ]]; then
+  echo "lint: no $build/compile_commands.json: configure that build first" >&2
+  exit 1
 fi
 
 # The compile commands of src/ only (not the tests, not the benchmarks).
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-python3 - "$build/compile_commands.json" "$work/compile_commands.json" "$root/src/" <<'PY'
+/usr/bin/python3 - "$build/compile_commands.json" "$work/compile_commands.json" "$root/src/" <<'PY'
 import json, sys
-entries = [e for e in json.load(open(sys.argv[1])) if e["file"].startswith(sys.argv[3])]
+entries = json.load(open(sys.argv[1]))
+if any("/Unity/unity_" in e["file"] for e in entries):
+    sys.exit(f"lint: {sys.argv[1]} compiles files in batches (unity build): configure with -DCMAKE_UNITY_BUILD=OFF")
+entries = [e for e in entries if e["file"].startswith(sys.argv[3])]
 if not entries:
     sys.exit(f"lint: no source of {sys.argv[3]} in {sys.argv[1]}")
 json.dump(entries, open(sys.argv[2], "w"), indent=1)

@@ -16,7 +16,7 @@ namespace {
 
 using Vector4 = Eigen::Vector4d;
 // Forward mode: each number carries its gradient with respect to (xi, U, W, p).
-using Dual = Eigen::AutoDiffScalar<Vector4>;
+using Dual4 = Eigen::AutoDiffScalar<Vector4>;
 
 // Test functions (normalised to [-1, 1]) smaller than this are rounding noise: no sign.
 constexpr double significance = 1e-9;
@@ -51,20 +51,20 @@ bool surface_parameter(Parameter p, bool wall, bool e)
 
 // The impact matrices along the path at s = value, each coefficient carrying its
 // derivative in s (the fourth independent variable).
-BasicModelMatrices<Dual> dual_matrices(const ParameterPath& path, double value)
+BasicModelMatrices<Dual4> dual_matrices(const ParameterPath& path, double value)
 {
     const auto coefficient = [value](double origin, double direction) {
-        Dual c(origin + value * direction);
+        Dual4 c(origin + value * direction);
         c.derivatives()(3) = direction;
         return c;
     };
     const auto matrix = [&](const Surface& o, const Surface& d) {
-        return BasicImpactMatrix<Dual>::of(coefficient(o.e, d.e), coefficient(o.alpha, d.alpha));
+        return BasicImpactMatrix<Dual4>::of(coefficient(o.e, d.e), coefficient(o.alpha, d.alpha));
     };
     return {matrix(path.origin.wall, path.direction.wall), matrix(path.origin.floor, path.direction.floor)};
 }
 
-CanonicalState<double> value_of(const CanonicalState<Dual>& c) { return {c.xi.value(), c.U.value(), c.W.value()}; }
+CanonicalState<double> value_of(const CanonicalState<Dual4>& c) { return {c.xi.value(), c.U.value(), c.W.value()}; }
 
 // det(m) divided by Hadamard's bound, the product of the rows' norms: in [-1, 1].
 template <int N>
@@ -327,7 +327,7 @@ struct Located {
     Node node;
     std::size_t after;  // index of the node the event follows
     double h;           // arclength from that node
-    Event event;
+    BranchEvent event;
     std::string note;
     double bracket;
 };
@@ -418,7 +418,7 @@ std::string boundary_note(TestKind k)
 // the event; nullopt when the eigenvalues do not confirm it (the test function changed sign
 // through a pole, where G^k is singular, or at a neutral saddle, mu_i mu_j = 1 for a real
 // pair).
-std::optional<std::pair<Event, std::string>> classify_event(TestKind kind, const Node& n)
+std::optional<std::pair<BranchEvent, std::string>> classify_event(TestKind kind, const Node& n)
 {
     const auto ev = sorted_eigenvalues(n.ev.g.dG);
     if (!ev) return std::nullopt;
@@ -429,20 +429,20 @@ std::optional<std::pair<Event, std::string>> classify_event(TestKind kind, const
     switch (kind) {
         case TestKind::fold:
             if (!has_eigenvalue(1.0)) return std::nullopt;
-            return std::pair{Event::fold, std::string()};
+            return std::pair{BranchEvent::fold, std::string()};
         case TestKind::branch:
             if (!has_eigenvalue(1.0)) return std::nullopt;
-            return std::pair{Event::branch_point, std::string()};
+            return std::pair{BranchEvent::branch_point, std::string()};
         case TestKind::kappa:
-            return std::pair{Event::branch_point, std::string("kappa = 1: an interior branch meets the plane")};
+            return std::pair{BranchEvent::branch_point, std::string("kappa = 1: an interior branch meets the plane")};
         case TestKind::period_doubling:
             if (!has_eigenvalue(-1.0)) return std::nullopt;
-            return std::pair{Event::period_doubling, std::string()};
+            return std::pair{BranchEvent::period_doubling, std::string()};
         case TestKind::neimark_sacker: {
             for (const auto& z : *ev) {
                 if (z.imag() > confirmation_tolerance && std::abs(std::abs(z) - 1.0) <= confirmation_tolerance) {
                     const double angle = std::arg(z);
-                    return std::pair{Event::neimark_sacker,
+                    return std::pair{BranchEvent::neimark_sacker,
                                      "angle " + format_double(angle) + " rad (" + format_double(angle / (2.0 * std::numbers::pi)) +
                                          " turns)"};
                 }
@@ -458,7 +458,7 @@ struct Direction {
     std::vector<Node> nodes;        // nodes[0] is the start
     std::vector<double> arclength;  // of each node, from the start
     std::vector<Located> events;
-    Event end = Event::none;  // how it stopped
+    BranchEvent end = BranchEvent::none;  // how it stopped
     std::string end_note;
     bool closed = false;  // came back to the start
 };
@@ -484,7 +484,7 @@ std::optional<Located> first_exit(const Context& c, const Node& a, const Node& b
                 bracket = 0.0;
             }
         }
-        stop = Located{std::move(n), ia, where.h, bound ? Event::end : Event::boundary,
+        stop = Located{std::move(n), ia, where.h, bound ? BranchEvent::end : BranchEvent::boundary,
                        bound ? bound_note(c.sys, kind == TestKind::upper_bound) : boundary_note(kind), bracket};
         if (bracket > location_tolerance * (1.0 + h)) stop->note += unlocated_note;
     }
@@ -539,7 +539,7 @@ Direction trace(const Context& c, const Node& start)
     double h = c.set.initial_step;
     while (true) {
         if (static_cast<int>(d.nodes.size()) > c.set.max_points) {
-            d.end = Event::end;
+            d.end = BranchEvent::end;
             d.end_note = "point limit " + std::to_string(c.set.max_points) + " reached";
             return d;
         }
@@ -551,7 +551,7 @@ Direction trace(const Context& c, const Node& start)
         if (!ok) {
             h *= 0.5;
             if (h < c.set.min_step) {
-                d.end = Event::end;
+                d.end = BranchEvent::end;
                 d.end_note = "the corrector fails at step sizes down to " + format_double(c.set.min_step);
                 return d;
             }
@@ -584,20 +584,13 @@ Direction trace(const Context& c, const Node& start)
         d.arclength.push_back(s);
         values.push_back(vb);
         if (passed_start) {
-            d.end = Event::end;
+            d.end = BranchEvent::end;
             d.end_note = "closed branch: back at the start";
             d.closed = true;
             return d;
         }
         if (iterations <= easy_iterations) h = std::min(h * growth, c.set.max_step);
     }
-}
-
-bool lexicographically_less(const CanonicalState<double>& a, const CanonicalState<double>& b)
-{
-    if (a.xi != b.xi) return a.xi < b.xi;
-    if (a.U != b.U) return a.U < b.U;
-    return a.W < b.W;
 }
 
 BranchPoint describe(const System& sys, const Node& n, double arclength)
@@ -647,13 +640,13 @@ std::vector<BranchPoint> points_of(const System& sys, const Direction& d, double
             out.push_back(std::move(p));
         }
     }
-    if (d.end == Event::end && (d.events.empty() || d.events.back().event != Event::end)) {
+    if (d.end == BranchEvent::end && (d.events.empty() || d.events.back().event != BranchEvent::end)) {
         // Stopped for a reason other than a located crossing: the last point says why.
         if (out.empty()) {
             BranchPoint p = describe(sys, d.nodes.back(), 0.0);
             out.push_back(std::move(p));
         }
-        out.back().event = Event::end;
+        out.back().event = BranchEvent::end;
         out.back().note = d.end_note;
     }
     return out;
@@ -743,20 +736,20 @@ ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const Mode
 
 ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const ParameterPath& path, double value, int k)
 {
-    const BasicModelMatrices<Dual> m = dual_matrices(path, value);
-    CanonicalState<Dual> c{Dual(s.xi, 4, 0), Dual(s.U, 4, 1), Dual(s.W, 4, 2)};
-    Dual lambda(1.0);
+    const BasicModelMatrices<Dual4> m = dual_matrices(path, value);
+    CanonicalState<Dual4> c{Dual4(s.xi, 4, 0), Dual4(s.U, 4, 1), Dual4(s.W, 4, 2)};
+    Dual4 lambda(1.0);
     ParameterJacobian r;
     r.orbit.reserve(static_cast<std::size_t>(std::max(k, 0)));
     for (int i = 0; i < k; ++i) {
         r.orbit.push_back(value_of(c));
-        const CanonicalStep<Dual> g = canonical_map(c, m);
+        const CanonicalStep<Dual4> g = canonical_map(c, m);
         lambda = lambda * g.lambda;
         c = g.next;
     }
     r.image = value_of(c);
     r.lambda = lambda.value();
-    const Dual* rows[3] = {&c.xi, &c.U, &c.W};
+    const Dual4* rows[3] = {&c.xi, &c.U, &c.W};
     for (int i = 0; i < 3; ++i) {
         r.dG.row(i) = rows[i]->derivatives().head<3>().transpose();
         r.dG_dp(i) = rows[i]->derivatives()(3);
@@ -766,16 +759,16 @@ ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const Para
     return r;
 }
 
-std::string_view name(Event e)
+std::string_view name(BranchEvent e)
 {
     switch (e) {
-        case Event::none: return "";
-        case Event::fold: return "fold";
-        case Event::period_doubling: return "period_doubling";
-        case Event::neimark_sacker: return "neimark_sacker";
-        case Event::branch_point: return "branch_point";
-        case Event::boundary: return "boundary";
-        case Event::end: return "end";
+        case BranchEvent::none: return "";
+        case BranchEvent::fold: return "fold";
+        case BranchEvent::period_doubling: return "period_doubling";
+        case BranchEvent::neimark_sacker: return "neimark_sacker";
+        case BranchEvent::branch_point: return "branch_point";
+        case BranchEvent::boundary: return "boundary";
+        case BranchEvent::end: return "end";
     }
     return "unknown";
 }

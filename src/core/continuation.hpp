@@ -104,9 +104,9 @@ ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const Mode
 // The same with the derivative along a path of coefficients, at path.at(value).
 ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const ParameterPath& path, double value, int k);
 
-enum class Event : std::uint8_t { none, fold, period_doubling, neimark_sacker, branch_point, boundary, end };
+enum class BranchEvent : std::uint8_t { none, fold, period_doubling, neimark_sacker, branch_point, boundary, end };
 
-std::string_view name(Event e);
+std::string_view name(BranchEvent e);
 
 // One point of a branch.
 struct BranchPoint {
@@ -120,7 +120,7 @@ struct BranchPoint {
     Stability stability = Stability::marginal;
     double residual = 0.0;   // max |G^k(point) - point| over the three coordinates
     double arclength = 0.0;  // signed, from the start, in (xi, U, W, p)
-    Event event = Event::none;
+    BranchEvent event = BranchEvent::none;
     // Events: width of the final bracket of the location in arclength, which bounds the
     // error of `parameter` (|dp/ds| <= 1); 0 where the point is solved at p = bound.
     double bracket = 0.0;

@@ -67,14 +67,14 @@ double relative_residual(const CanonicalState<double>& s, const ModelMatrices& m
     return image ? relative_size(log_residual(s, *image, domain), s) : HUGE_VAL;
 }
 
+}  // namespace
+
 bool lexicographically_less(const CanonicalState<double>& a, const CanonicalState<double>& b)
 {
     if (a.xi != b.xi) return a.xi < b.xi;
     if (a.U != b.U) return a.U < b.U;
     return a.W < b.W;
 }
-
-}  // namespace
 
 StepJacobian step_jacobian(const CanonicalState<double>& s, const ModelMatrices& m)
 {

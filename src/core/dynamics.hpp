@@ -60,6 +60,8 @@ inline bool in_domain(const CanonicalState<double>& c, Domain d)
 
 inline Eigen::Vector3d as_vector(const CanonicalState<double>& c) { return {c.xi, c.U, c.W}; }
 inline CanonicalState<double> as_state(const Eigen::Vector3d& v) { return {v(0), v(1), v(2)}; }
+// The order that picks a cycle's representative (fixed-points, continuation): by xi, then U, then W.
+bool lexicographically_less(const CanonicalState<double>& a, const CanonicalState<double>& b);
 
 // G, lambda and their derivatives with respect to (xi, U, W) at one state.
 struct StepJacobian {

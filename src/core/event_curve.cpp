@@ -14,7 +14,7 @@ namespace {
 constexpr double line_half_width = 2.0;
 // The event found within this fraction of a step from the prediction: the next step grows.
 constexpr double easy_fraction = 0.25;
-constexpr double growth = 1.5;
+constexpr double curve_growth = 1.5;
 
 struct Plane {
     Model model;  // the other coefficients
@@ -49,7 +49,7 @@ Eigen::Vector2d fold_side(const std::vector<BranchPoint>& points, std::size_t i,
 
 // What is traced: an event of a cycle of some period, in a domain of the map.
 struct Sought {
-    Event event;
+    BranchEvent event;
     int period;
     Domain domain;
 };
@@ -87,12 +87,12 @@ std::optional<Found> locate_on_line(const Plane& plane, const Sought& sought, co
         if (p.event != event) continue;
         if (best && std::abs(best->s) <= std::abs(p.parameter)) continue;
         best = Found{q1 + p.parameter * n1, q2 + p.parameter * n2, p, p.parameter};
-        if (event == Event::fold) best->side = fold_side(branch->points, i, Eigen::Vector2d(n1, n2));
+        if (event == BranchEvent::fold) best->side = fold_side(branch->points, i, Eigen::Vector2d(n1, n2));
     }
     return best;
 }
 
-struct Direction {
+struct HalfCurve {
     std::vector<Found> points;
     std::string end;
 };
@@ -102,10 +102,10 @@ bool inside(const EventCurveSettings& set, double a, double b)
     return a >= set.min1 && a <= set.max1 && b >= set.min2 && b <= set.max2;
 }
 
-Direction trace(const Plane& plane, const Found& start, double sign, const Sought& sought, const EventCurveSettings& set)
+HalfCurve trace(const Plane& plane, const Found& start, double sign, const Sought& sought, const EventCurveSettings& set)
 {
-    const Event event = sought.event;
-    Direction d;
+    const BranchEvent event = sought.event;
+    HalfCurve d;
     Found last = start;
     double h = set.initial_step;
     // First step: along the second coefficient, the line along the first.
@@ -129,7 +129,7 @@ Direction trace(const Plane& plane, const Found& start, double sign, const Sough
         if (n.dot(last.side) < 0.0) n = -n;
         std::optional<Found> found;
         for (const double s0 : {0.0, 0.5, 1.0, 2.0}) {
-            if (s0 > 0.0 && event != Event::fold) break;
+            if (s0 > 0.0 && event != BranchEvent::fold) break;
             found = locate_on_line(plane, sought, as_state(x), {q1, q2, n(0), n(1)}, s0 * h, line_half_width * h);
             if (found) break;
         }
@@ -150,7 +150,7 @@ Direction trace(const Plane& plane, const Found& start, double sign, const Sough
         }
         velocity = (as_vector(found->point.point) - as_vector(last.point.point)) / length;
         direction = step / length;
-        if (std::abs(found->s) < easy_fraction * h) h = std::min(h * growth, set.max_step);
+        if (std::abs(found->s) < easy_fraction * h) h = std::min(h * curve_growth, set.max_step);
         d.points.push_back(*found);
         last = *found;
     }
@@ -180,15 +180,15 @@ std::optional<EventCurve> continue_event(const Branch& branch, std::size_t index
 {
     if (index >= branch.points.size() || !independent(first, second)) return std::nullopt;
     const BranchPoint& e = branch.points[index];
-    const bool curve_event = e.event == Event::fold || e.event == Event::period_doubling ||
-                             e.event == Event::neimark_sacker || e.event == Event::branch_point;
+    const bool curve_event = e.event == BranchEvent::fold || e.event == BranchEvent::period_doubling ||
+                             e.event == BranchEvent::neimark_sacker || e.event == BranchEvent::branch_point;
     if (!curve_event) return std::nullopt;
     const Plane plane{with_parameter(model, first, e.parameter), first, second};
     Found start{e.parameter, parameter_value(model, second), e, 0.0};
-    if (e.event == Event::fold) start.side = fold_side(branch.points, index, Eigen::Vector2d(1.0, 0.0));
+    if (e.event == BranchEvent::fold) start.side = fold_side(branch.points, index, Eigen::Vector2d(1.0, 0.0));
     const Sought sought{e.event, branch.period, branch.domain};
-    const Direction up = trace(plane, start, 1.0, sought, settings);
-    const Direction down = trace(plane, start, -1.0, sought, settings);
+    const HalfCurve up = trace(plane, start, 1.0, sought, settings);
+    const HalfCurve down = trace(plane, start, -1.0, sought, settings);
     if (up.points.empty() && down.points.empty()) return std::nullopt;
     EventCurve c;
     c.event = e.event;

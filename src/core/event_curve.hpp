@@ -33,7 +33,7 @@ struct EventCurvePoint {
 };
 
 struct EventCurve {
-    Event event = Event::none;
+    BranchEvent event = BranchEvent::none;
     int period = 1;
     Domain domain = Domain::interior;
     std::vector<EventCurvePoint> points;  // from one end to the other

@@ -12,7 +12,7 @@
 
 namespace superball {
 
-// Not core/trajectory.hpp: its Event would meet core/continuation.hpp's in files using both.
+// Declared, not included: this header's users need not compile core/trajectory.hpp.
 struct Trajectory;
 
 // {"e_wall": ..., "alpha_wall": ..., "e_floor": ..., "alpha_floor": ...}

@@ -1,6 +1,5 @@
 // superball._core's dynamics: fixed_points() and continue_branch() (run/cycles.hpp,
-// run/continuation.hpp), in a file of their own: core/continuation.hpp's Event (a
-// continuation event) and core/trajectory.hpp's Event (an impact) share a name.
+// run/continuation.hpp).
 #include <pybind11/complex.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -116,7 +116,7 @@ BranchPoint get_point(Reader& r)
     p.stability = static_cast<Stability>(r.integer());
     p.residual = r.number();
     p.arclength = r.number();
-    p.event = static_cast<Event>(r.integer());
+    p.event = static_cast<BranchEvent>(r.integer());
     p.bracket = r.number();
     p.note = r.text();
     return p;
@@ -171,7 +171,7 @@ std::pair<std::size_t, std::optional<EventCurve>> get_curve(Reader& r)
     const std::size_t index = r.size();
     if (r.number() == 0.0) return {index, std::nullopt};
     EventCurve c;
-    c.event = static_cast<Event>(r.integer());
+    c.event = static_cast<BranchEvent>(r.integer());
     c.period = r.integer();
     c.domain = static_cast<Domain>(r.integer());
     c.start = r.size();
@@ -246,9 +246,9 @@ bool on_branch(const Branch& b, const Cycle& c, const ContinuationRun& run)
     return false;
 }
 
-bool curve_event(Event e)
+bool curve_event(BranchEvent e)
 {
-    return e == Event::fold || e == Event::period_doubling || e == Event::neimark_sacker || e == Event::branch_point;
+    return e == BranchEvent::fold || e == BranchEvent::period_doubling || e == BranchEvent::neimark_sacker || e == BranchEvent::branch_point;
 }
 
 // The event curves of the branches (on rank 0), computed curve i on rank i mod size. Every

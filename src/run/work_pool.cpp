@@ -86,7 +86,7 @@ int first_of_share(int share, int leaders, int writers)
 }
 int share_of(int leader, int leaders, int writers) { return static_cast<int>(std::int64_t{leader} * writers / leaders); }
 
-struct Range {
+struct TileRange {
     std::uint64_t first = 0;
     std::uint64_t count = 0;
 };
@@ -107,7 +107,7 @@ std::uint64_t guided_block(std::uint64_t remaining, std::uint64_t ranks, std::ui
 // At most n tiles from the front of `r`, so that a block of a granule or more starts and
 // ends on granule boundaries: a range given back from the middle of a granule (ranks give
 // back tiles one by one, not granules) goes out first up to the next boundary.
-std::uint64_t aligned_block(Range r, std::uint64_t n, std::uint64_t granule)
+std::uint64_t aligned_block(TileRange r, std::uint64_t n, std::uint64_t granule)
 {
     if (granule <= 1 || n < granule) return n;
     const std::uint64_t into = r.first % granule;
@@ -291,16 +291,16 @@ private:
     {
         const std::uint64_t left =
             root_ ? pool_tiles_ : parent_remaining_ + pool_tiles_ * computing_ranks_ / node_computing_ranks_;
-        const Range& front = pool_.front();
+        const TileRange& front = pool_.front();
         const std::uint64_t n =
             std::min(front.count, guided_block(left, computing_ranks_, weight, settings_.granule, settings_.block_divisor));
         return aligned_block(front, n, settings_.granule);
     }
 
-    Range take(std::uint64_t n)
+    TileRange take(std::uint64_t n)
     {
-        Range& front = pool_.front();
-        const Range r{front.first, n};
+        TileRange& front = pool_.front();
+        const TileRange r{front.first, n};
         front.first += n;
         front.count -= n;
         pool_tiles_ -= n;
@@ -308,7 +308,7 @@ private:
         return r;
     }
 
-    void add_to_pool(Range r)
+    void add_to_pool(TileRange r)
     {
         if (r.count == 0) return;
         pool_.push_back(r);
@@ -346,7 +346,7 @@ private:
 
     // This rank's unstarted tiles but the next (the end of its queue, then the end of its
     // current block), taken away: at most two ranges.
-    std::vector<Range> take_back_surplus()
+    std::vector<TileRange> take_back_surplus()
     {
         const std::uint64_t n = surplus(current_.count + pool_tiles_);
         stats.given_back += n;
@@ -358,11 +358,11 @@ private:
     // the ranges given back at the end of a run are written in smaller pieces instead.)
     static std::uint64_t surplus(std::uint64_t n) { return n > 1 ? n - 1 : 0; }
 
-    std::vector<Range> take_back(std::uint64_t n)
+    std::vector<TileRange> take_back(std::uint64_t n)
     {
-        std::vector<Range> out;
+        std::vector<TileRange> out;
         while (n > 0 && !pool_.empty()) {
-            Range& back = pool_.back();
+            TileRange& back = pool_.back();
             const std::uint64_t k = std::min(n, back.count);
             out.push_back({back.first + back.count - k, k});
             back.count -= k;
@@ -518,14 +518,14 @@ private:
         done_(reports, rank, payload);
     }
 
-    void send_up(std::uint64_t flags, const std::vector<Range>& given = {})
+    void send_up(std::uint64_t flags, const std::vector<TileRange>& given = {})
     {
         sent_idle_ = idle_ranks();
         std::vector<std::uint64_t> msg{flags, children_.empty() ? 1 : node_computing_ranks_, unstarted(), received_,
                                        sent_idle_, std::exchange(want_, 0), outbox_groups_};
         msg.insert(msg.end(), outbox_.begin(), outbox_.end());
         msg.push_back(given.size());
-        for (const Range& r : given) msg.insert(msg.end(), {r.first, r.count});
+        for (const TileRange& r : given) msg.insert(msg.end(), {r.first, r.count});
         // Its memory too: a rank's batch of compressed tiles passes through it once a second or
         // at 4 MiB, and kept, that much would stay on every rank for the rest of the run.
         std::vector<std::uint64_t>().swap(outbox_);
@@ -535,7 +535,7 @@ private:
         ++stats.messages_out;
     }
 
-    void send_down(Child& c, Down kind, Range r = {})
+    void send_down(Child& c, Down kind, TileRange r = {})
     {
         const std::array<std::uint64_t, down_words> msg = {static_cast<std::uint64_t>(kind), r.first, r.count, pool_tiles_};
         links_.send_down(c.peer, msg);
@@ -618,7 +618,7 @@ private:
             ++stats.grants;
             send_down(c, Down::space, {f.address, f.bytes});
         }
-        std::vector<Range> given(msg[at]);
+        std::vector<TileRange> given(msg[at]);
         for (std::size_t i = 0; i < given.size(); ++i) given[i] = {msg[at + 1 + 2 * i], msg[at + 2 + 2 * i]};
 
         if (flags & final_message) c.active = false;  // nothing more to tell it but goodbye
@@ -631,7 +631,7 @@ private:
             // they were on their way): not asked again before its next message says so,
             // or rank 0 and a leader would trade requests and empty answers. Asked for all
             // but one, it may still hold that one (for Down::give_one at the end).
-            if (std::all_of(given.begin(), given.end(), [](const Range& r) { return r.count == 0; })) {
+            if (std::all_of(given.begin(), given.end(), [](const TileRange& r) { return r.count == 0; })) {
                 c.unstarted = c.asked_one ? 0 : std::min<std::uint64_t>(c.unstarted, 1);
             }
             c.asked_one = false;
@@ -650,7 +650,7 @@ private:
         c.waiting = false;
         if (stopped_) return;  // the stop message is, or will be, on its way instead
         if (pool_tiles_ > 0) {
-            const Range r = take(block_for(c.weight));
+            const TileRange r = take(block_for(c.weight));
             stats.handed_out.push_back(r.count);
             c.assigned += r.count;
             c.in_flight += r.count;
@@ -663,7 +663,7 @@ private:
 
     // Tiles given back by rank c, which this one serves: passed up with the others once
     // every rank asked for this rank's server has answered, handed out here otherwise.
-    void received_back(Child& c, const std::vector<Range>& given)
+    void received_back(Child& c, const std::vector<TileRange>& given)
     {
         if (c.for_server) {
             c.for_server = false;
@@ -671,7 +671,7 @@ private:
             if (--owed_answers_ == 0) pass_gathered_up();
             return;
         }
-        for (const Range& r : given) add_to_pool(r);
+        for (const TileRange& r : given) add_to_pool(r);
         serve_waiting();
     }
 
@@ -853,7 +853,7 @@ private:
         if (waiting > 0 && current_.count >= 2 && (!fullest || current_.count >= fullest->unstarted)) {
             const std::uint64_t n = surplus(current_.count);
             stats.given_back += n;
-            for (const Range& r : take_back(n)) add_to_pool(r);
+            for (const TileRange& r : take_back(n)) add_to_pool(r);
             serve_waiting();
             return;
         }
@@ -866,7 +866,7 @@ private:
         if ((last_word || parent_remaining_ == 0) && asked == 0 && fullest_child() == nullptr) {
             if (computing_ && current_.count == 1 && waiting > 0) {
                 ++stats.given_back;
-                for (const Range& r : take_back(1)) add_to_pool(r);
+                for (const TileRange& r : take_back(1)) add_to_pool(r);
                 serve_waiting();
                 return;
             }
@@ -1002,14 +1002,14 @@ private:
     bool parent_end_ = false;   // the server has no more blocks
     bool owe_back_ = false;     // the server asked for tiles back; ranks served here were asked in turn
     std::uint64_t owed_answers_ = 0;  // of which have not answered
-    std::vector<Range> gathered_;     // tiles for the server so far
+    std::vector<TileRange> gathered_;     // tiles for the server so far
     std::uint64_t parent_remaining_ = 0;
     std::uint64_t received_ = 0;  // tiles the server assigned this rank so far
     std::uint64_t sent_idle_ = 0;  // idle ranks counted in the last message up
 
-    std::deque<Range> pool_;
+    std::deque<TileRange> pool_;
     std::uint64_t pool_tiles_ = 0;
-    Range current_;  // unstarted tiles of the block being computed
+    TileRange current_;  // unstarted tiles of the block being computed
     std::uint64_t unflushed_ = 0;  // tiles computed since the last flush
     std::vector<std::uint64_t> outbox_;  // report groups to send up
     std::uint64_t outbox_groups_ = 0;

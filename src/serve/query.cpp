@@ -24,8 +24,6 @@ std::string either(const std::vector<std::string>& words)
 
 namespace {
 
-[[noreturn]] void refuse(const std::string& message) { throw RequestError(400, message); }
-
 // A parameter's value as it was written, quoted when it is not a plain word or number.
 std::string as_written(std::string_view value)
 {

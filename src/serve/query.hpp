@@ -20,6 +20,9 @@ struct RequestError : std::runtime_error {
     int status;
 };
 
+// A request the API refuses as bad (HTTP 400), saying why.
+[[noreturn]] inline void refuse(const std::string& message) { throw RequestError(400, message); }
+
 // The query string, as decoded by the HTTP library (a key may come more than once).
 using Parameters = std::multimap<std::string, std::string>;
 

@@ -7,8 +7,6 @@ namespace superball::serve {
 
 namespace {
 
-[[noreturn]] void refuse(const std::string& message) { throw RequestError(400, message); }
-
 // The API spells every key as it is named in the query string.
 std::string as_is(std::string_view key) { return std::string(key); }
 

@@ -60,7 +60,7 @@ Branch branch_of(const CanonicalState<double>& near, const Model& model, Paramet
     return b ? *b : Branch{};
 }
 
-std::vector<BranchPoint> events_of(const Branch& b, Event e)
+std::vector<BranchPoint> events_of(const Branch& b, BranchEvent e)
 {
     std::vector<BranchPoint> out;
     std::copy_if(b.points.begin(), b.points.end(), std::back_inserter(out),
@@ -68,11 +68,11 @@ std::vector<BranchPoint> events_of(const Branch& b, Event e)
     return out;
 }
 
-std::vector<Event> event_sequence(const Branch& b)
+std::vector<BranchEvent> event_sequence(const Branch& b)
 {
-    std::vector<Event> out;
+    std::vector<BranchEvent> out;
     for (const BranchPoint& p : b.points) {
-        if (p.event != Event::none) out.push_back(p.event);
+        if (p.event != BranchEvent::none) out.push_back(p.event);
     }
     return out;
 }
@@ -172,7 +172,7 @@ void expect_points_are_newton_cycles(const Branch& b, const Model& model, Parame
     int checked = 0;
     for (std::size_t i = 0; i < b.points.size(); i += static_cast<std::size_t>(every)) {
         const BranchPoint& q = b.points[i];
-        if (q.event != Event::none || (b.domain == Domain::interior && q.representative.xi < 1e-6)) continue;
+        if (q.event != BranchEvent::none || (b.domain == Domain::interior && q.representative.xi < 1e-6)) continue;
         SCOPED_TRACE(testing::Message() << "point " << i << " at " << name(parameter) << " = " << q.parameter);
         const auto c = reference_cycle(q.representative, model, parameter, q.parameter, b.period, b.domain);
         ASSERT_TRUE(c.has_value());
@@ -204,7 +204,7 @@ TEST(Continuation, ElasticFamilyHasNoFalseEvents)
         EXPECT_NEAR(q.point.xi, (1.0 + q.point.U) / 2.0, 1e-9);
         EXPECT_NEAR(q.point.W, 2.5 * q.point.U, 1e-9);
     }
-    EXPECT_EQ(event_sequence(b), (std::vector<Event>{Event::boundary, Event::boundary}));
+    EXPECT_EQ(event_sequence(b), (std::vector<BranchEvent>{BranchEvent::boundary, BranchEvent::boundary}));
     const BranchPoint& corner = b.points.front();
     EXPECT_EQ(corner.note, "xi -> 0");
     EXPECT_NEAR(corner.point.U, -1.0, 1e-9);
@@ -220,14 +220,14 @@ TEST(Continuation, ElasticFamilyBranchPointWhereTheDissipativeBranchAttaches)
 {
     const Model elastic = Model::uniform(1.0, 1.0);
     const Branch b = branch_of({0.25, -0.5, -1.25}, elastic, Parameter::e, 1, 0.5, 1.0);
-    const auto bp = events_of(b, Event::branch_point);
+    const auto bp = events_of(b, BranchEvent::branch_point);
     ASSERT_EQ(bp.size(), 1u);
     // At a branch point the corrector's matrix is singular: the point is located to about
     // the square root of the rounding error (the AVX-512 build of Eigen's LU puts e at
     // 1 + 2.3e-8, the portable one within 1e-8), not to the corrector's tolerance.
     EXPECT_NEAR(bp[0].point.U, -1.0 / 3.0, 1e-7);
     EXPECT_NEAR(bp[0].parameter, 1.0, 1e-7);
-    EXPECT_EQ(event_sequence(b), (std::vector<Event>{Event::boundary, Event::branch_point, Event::boundary}));
+    EXPECT_EQ(event_sequence(b), (std::vector<BranchEvent>{BranchEvent::boundary, BranchEvent::branch_point, BranchEvent::boundary}));
     for (const double d : {1e-3, 1e-4}) {
         const auto c = reference_cycle(bp[0].point, Model::uniform(1.0 - d, 1.0), Parameter::e, 1.0 - d, 1,
                                        Domain::interior);
@@ -274,14 +274,14 @@ TEST(Continuation, CornerBranchPointsAreCycles)
 TEST(Continuation, InteriorBranchMeetsTheCornerBranchAtItsBranchPoint)
 {
     const Dissipative& d = dissipative_branches();
-    EXPECT_EQ(event_sequence(d.interior), (std::vector<Event>{Event::boundary, Event::neimark_sacker,
-                                                               Event::neimark_sacker, Event::end}));
-    EXPECT_EQ(event_sequence(d.corner), (std::vector<Event>{Event::end, Event::neimark_sacker, Event::branch_point,
-                                                             Event::end}));
+    EXPECT_EQ(event_sequence(d.interior), (std::vector<BranchEvent>{BranchEvent::boundary, BranchEvent::neimark_sacker,
+                                                               BranchEvent::neimark_sacker, BranchEvent::end}));
+    EXPECT_EQ(event_sequence(d.corner), (std::vector<BranchEvent>{BranchEvent::end, BranchEvent::neimark_sacker, BranchEvent::branch_point,
+                                                             BranchEvent::end}));
     const BranchPoint& meet = d.interior.points.front();
     EXPECT_EQ(meet.note, "xi -> 0");
     EXPECT_LT(meet.point.xi, 1e-12);
-    const BranchPoint bp = events_of(d.corner, Event::branch_point).at(0);
+    const BranchPoint bp = events_of(d.corner, BranchEvent::branch_point).at(0);
     EXPECT_NEAR(meet.parameter, bp.parameter, 1e-9);
     EXPECT_NEAR(meet.point.U, bp.point.U, 1e-7);
     EXPECT_NEAR(meet.point.W, bp.point.W, 1e-7);
@@ -314,7 +314,7 @@ TEST(Continuation, NeimarkSackerIsAPairCrossingTheUnitCircle)
     for (const Branch* b : {&d.interior, &d.corner}) {
         for (std::size_t i = 1; i + 1 < b->points.size(); ++i) {
             const BranchPoint& q = b->points[i];
-            if (q.event != Event::neimark_sacker) continue;
+            if (q.event != BranchEvent::neimark_sacker) continue;
             ++seen;
             SCOPED_TRACE(testing::Message() << "alpha = " << q.parameter);
             EXPECT_NEAR(pair_modulus(q.eigenvalues), 1.0, 1e-7);
@@ -348,7 +348,7 @@ TEST(Continuation, FoldOfAPeriod3Cycle)
     // The first event after the start in increasing alpha.
     const auto first_fold = [](const Branch& b) {
         for (std::size_t i = b.start; i < b.points.size(); ++i) {
-            if (b.points[i].event == Event::fold) return i;
+            if (b.points[i].event == BranchEvent::fold) return i;
         }
         return b.points.size();
     };
@@ -410,7 +410,7 @@ TEST(Continuation, FoldOfAPeriod3Cycle)
 TEST(Continuation, PeriodDoublingIsARealEigenvalueThroughMinusOne)
 {
     const Branch b = branch_of(period3_start, dissipative, Parameter::alpha, 3, 0.98, 1.0);
-    const auto pd = events_of(b, Event::period_doubling);
+    const auto pd = events_of(b, BranchEvent::period_doubling);
     ASSERT_FALSE(pd.empty());
     for (const BranchPoint& q : pd) {
         SCOPED_TRACE(testing::Message() << "alpha = " << q.parameter);
@@ -432,7 +432,7 @@ TEST(Continuation, PeriodDoublingIsARealEigenvalueThroughMinusOne)
 
 // ---- Event curves in (alpha, e) ----------------------------------------------------------
 
-EventCurve curve_of(const Branch& b, Event e, std::size_t nth, double min_e, double max_e)
+EventCurve curve_of(const Branch& b, BranchEvent e, std::size_t nth, double min_e, double max_e)
 {
     std::size_t seen = 0;
     for (std::size_t i = 0; i < b.points.size(); ++i) {
@@ -491,7 +491,7 @@ void expect_curve_matches_one_parameter_continuation(const EventCurve& c, double
 // one side and outside on the other (cycles of dynamics.cpp 1e-6 away in alpha).
 TEST(EventCurve, NeimarkSackerCurveOfTheCornerFixedPoint)
 {
-    const EventCurve c = curve_of(dissipative_branches().corner, Event::neimark_sacker, 0, 0.5, 0.99);
+    const EventCurve c = curve_of(dissipative_branches().corner, BranchEvent::neimark_sacker, 0, 0.5, 0.99);
     EXPECT_EQ(c.domain, Domain::corner);
     EXPECT_EQ(c.points[c.start].second, 0.9);
     for (std::size_t i = 0; i + 1 < c.points.size(); ++i) {
@@ -522,7 +522,7 @@ TEST(EventCurve, NeimarkSackerCurveOfTheCornerFixedPoint)
 // at the corner plane: kappa = 1 of the corner cycle of dynamics.cpp along it.
 TEST(EventCurve, BranchPointCurveWhereInteriorFixedPointsMeetTheCorner)
 {
-    const EventCurve c = curve_of(dissipative_branches().corner, Event::branch_point, 0, 0.5, 0.99);
+    const EventCurve c = curve_of(dissipative_branches().corner, BranchEvent::branch_point, 0, 0.5, 0.99);
     for (std::size_t i = 0; i < c.points.size(); i += 5) {
         const EventCurvePoint& p = c.points[i];
         SCOPED_TRACE(testing::Message() << "alpha = " << p.first << ", e = " << p.second);
@@ -542,7 +542,7 @@ TEST(EventCurve, BranchPointCurveWhereInteriorFixedPointsMeetTheCorner)
 TEST(EventCurve, FoldCurveOfAPeriod3Cycle)
 {
     const Branch b = branch_of(period3_start, dissipative, Parameter::alpha, 3, 0.98, 1.0);
-    const EventCurve c = curve_of(b, Event::fold, 0, 0.85, 0.95);
+    const EventCurve c = curve_of(b, BranchEvent::fold, 0, 0.85, 0.95);
     for (const EventCurvePoint& p : c.points) {
         const auto ev1 = std::min_element(p.point.eigenvalues.begin(), p.point.eigenvalues.end(),
                                           [](auto x, auto y) { return std::abs(x - 1.0) < std::abs(y - 1.0); });
@@ -558,7 +558,7 @@ TEST(EventCurve, RefusesWhatIsNoCurve)
     // An end point is no event to follow; alpha and alpha_wall are not independent.
     EXPECT_FALSE(continue_event(b, 0, dissipative, Parameter::alpha, Parameter::e, s));
     for (std::size_t i = 0; i < b.points.size(); ++i) {
-        if (b.points[i].event == Event::neimark_sacker) {
+        if (b.points[i].event == BranchEvent::neimark_sacker) {
             EXPECT_FALSE(continue_event(b, i, dissipative, Parameter::alpha, Parameter::alpha_wall, s));
         }
     }

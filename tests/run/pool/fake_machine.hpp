@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -311,5 +312,16 @@ private:
     bool ended_ = false;
     std::exception_ptr error_;
 };
+
+// The tiles 0 .. n-1 in order: a hand-out list.
+inline std::vector<ListedTile> listed_tiles(std::uint64_t n)
+{
+    std::vector<ListedTile> v(n);
+    std::iota(v.begin(), v.end(), 0);
+    return v;
+}
+
+// The checksum the fake work gives a tile (any function of the tile that the record can check).
+inline std::uint64_t checksum_of(std::uint64_t tile) { return tile * 0x9E3779B97F4A7C15ull + 1; }
 
 }  // namespace superball::testing

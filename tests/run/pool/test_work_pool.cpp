@@ -12,7 +12,6 @@
 #include <cstring>
 #include <functional>
 #include <map>
-#include <numeric>
 #include <set>
 #include <vector>
 
@@ -24,14 +23,8 @@ namespace {
 
 using testing::FakeMachine;
 
-std::uint64_t checksum_of(std::uint64_t tile) { return tile * 0x9E3779B97F4A7C15ull + 1; }
-
-std::vector<ListedTile> iota(std::uint64_t n)
-{
-    std::vector<ListedTile> v(n);
-    std::iota(v.begin(), v.end(), 0);
-    return v;
-}
+using testing::checksum_of;
+using testing::listed_tiles;
 
 using Cost = std::function<double(std::uint64_t tile)>;  // simulated seconds
 
@@ -154,7 +147,7 @@ TEST(HandOut, EveryTileOnceBlocksShrinkAndAreFew)
     const int ranks = 4;
     const std::uint64_t n = 2000;
     FakeMachine m({.ranks = ranks});
-    const std::vector<ListedTile> pending = iota(n);
+    const std::vector<ListedTile> pending = listed_tiles(n);
     const Record rec = run(m, ranks, pending, [](std::uint64_t) { return 1e-3; }, {});
     expect_every_tile_once(rec, pending);
     const std::vector<std::uint64_t>& blocks = rec.results[0].stats.handed_out;
@@ -175,7 +168,7 @@ TEST(HandOut, EveryTileOnceBlocksShrinkAndAreFew)
 TEST(HandOut, OneRankComputesEverythingWithoutAMessage)
 {
     FakeMachine m({.ranks = 1});
-    const std::vector<ListedTile> pending = iota(100);
+    const std::vector<ListedTile> pending = listed_tiles(100);
     const Record rec = run(m, 1, pending, [](std::uint64_t) { return 1e-3; }, {});
     expect_every_tile_once(rec, pending);
     EXPECT_EQ(rec.results[0].stats.messages_in, 0u);
@@ -190,7 +183,7 @@ TEST(HandOut, NodeLeadersServeTheirNodes)
     FakeMachine m({.ranks = ranks, .node_ranks = 8});
     ScheduleSettings s;
     s.dedicated_root_ranks = 16;
-    const std::vector<ListedTile> pending = iota(6000);
+    const std::vector<ListedTile> pending = listed_tiles(6000);
     const Record rec = run(m, ranks, pending, [](std::uint64_t t) { return 1e-4 * (1 + t % 7); }, s);
     expect_every_tile_once(rec, pending);
     EXPECT_FALSE(rec.results[0].stats.computed);
@@ -221,7 +214,7 @@ TEST(GiveBack, CostlyTilesAreSharedWhenTheyCluster)
     const std::uint64_t n = 400;
     FakeMachine m({.ranks = ranks});
     const Cost cost = [n](std::uint64_t t) { return 8 * t < n ? 50e-3 : 1e-3; };
-    const std::vector<ListedTile> pending = iota(n);
+    const std::vector<ListedTile> pending = listed_tiles(n);
     const Record rec = run(m, ranks, pending, cost, {});
     expect_every_tile_once(rec, pending);
     double work = 0;
@@ -241,7 +234,7 @@ TEST(GiveBack, AcrossNodes)
     ScheduleSettings s;
     s.dedicated_root_ranks = 8;
     const Cost cost = [](std::uint64_t t) { return t < 150 ? 50e-3 : 1e-3; };
-    const std::vector<ListedTile> pending = iota(n);
+    const std::vector<ListedTile> pending = listed_tiles(n);
     const Record rec = run(m, ranks, pending, cost, s);
     expect_every_tile_once(rec, pending);
     double work = 0;
@@ -265,7 +258,7 @@ TEST(Tail, TheLastCostlyTilesEndOnDifferentRanks)
 {
     for (const auto& [ranks, dedicated] : {std::pair{3, false}, {4, true}, {5, true}}) {
         const std::uint64_t n = 20 * static_cast<std::uint64_t>(ranks);
-        const std::vector<ListedTile> pending = iota(n);
+        const std::vector<ListedTile> pending = listed_tiles(n);
         ScheduleSettings s;
         s.dedicated_root_ranks = dedicated ? 2 : 0;
         for (std::uint64_t i = n - 8; i < n; ++i) {
@@ -328,7 +321,7 @@ TEST(Resume, StopThenResumeRecordsEveryTileOnce)
 {
     for (const int node_ranks : {0, 2}) {
         const int ranks = 6;
-        const std::vector<ListedTile> all = iota(3000);
+        const std::vector<ListedTile> all = listed_tiles(3000);
         const Cost cost = [](std::uint64_t t) { return 1e-3 * (1 + t % 3); };
         ScheduleSettings s;
         s.report_seconds = 0.05;
@@ -357,7 +350,7 @@ TEST(LostRank, OnlyTilesNeverRecordedAreComputedAgain)
 {
     for (const int node_ranks : {0, 4}) {
         const int ranks = 8;
-        const std::vector<ListedTile> all = iota(4000);
+        const std::vector<ListedTile> all = listed_tiles(4000);
         const Cost cost = [](std::uint64_t t) { return 1e-3 * (1 + t % 4); };
         ScheduleSettings s;
         s.report_seconds = 0.1;

@@ -22,13 +22,14 @@ namespace {
 
 using testing::FakeMachine;
 
-std::uint64_t checksum_of(std::uint64_t tile) { return tile * 0x9E3779B97F4A7C15ull + 1; }
+using testing::checksum_of;
+using testing::listed_tiles;
 // A tile's stored bytes: sizes that vary, as compressed tiles' do.
 std::uint64_t bytes_of(std::uint64_t tile) { return 100 + tile % 37 * 10; }
 
 // What every rank saw, checked by the tests.
-struct Record {
-    explicit Record(int ranks) : computed(static_cast<std::size_t>(ranks)), results(static_cast<std::size_t>(ranks)) {}
+struct WritersRecord {
+    explicit WritersRecord(int ranks) : computed(static_cast<std::size_t>(ranks)), results(static_cast<std::size_t>(ranks)) {}
     std::vector<std::vector<std::uint64_t>> computed;  // per rank
     std::map<std::uint64_t, int> recorded;             // rank 0's record: tile -> the rank that wrote it
     std::map<std::uint64_t, int> written;              // tile -> the rank whose writes ended (0: rank 0's own share)
@@ -64,9 +65,9 @@ bool names_its_tiles(std::span<const TileReport> tiles, std::span<const std::byt
            std::all_of(tiles.begin(), tiles.end(), [](const TileReport& t) { return t.checksum == checksum_of(t.tile); });
 }
 
-class FakeWork final : public TileWork {
+class WritersWork final : public TileWork {
 public:
-    FakeWork(FakeMachine& m, int rank, Record& rec) : m_(m), rank_(rank), rec_(rec) {}
+    WritersWork(FakeMachine& m, int rank, WritersRecord& rec) : m_(m), rank_(rank), rec_(rec) {}
     void compute(std::uint64_t tile, const Serve& serve) override
     {
         for (int i = 0; i < 4; ++i) {
@@ -87,7 +88,7 @@ public:
 private:
     FakeMachine& m_;
     int rank_;
-    Record& rec_;
+    WritersRecord& rec_;
     std::vector<TileReport> buffered_;
 };
 
@@ -95,7 +96,7 @@ private:
 // each write taking 2 ms of the machine's clock from its placing.
 class FakeSink final : public TileSink {
 public:
-    FakeSink(FakeMachine& m, int rank, Record& rec) : m_(m), rank_(rank), rec_(rec) {}
+    FakeSink(FakeMachine& m, int rank, WritersRecord& rec) : m_(m), rank_(rank), rec_(rec) {}
     void add(std::span<const TileReport> tiles, std::span<const std::byte> payload) override
     {
         if (!names_its_tiles(tiles, payload)) ++rec_.bad_payloads;
@@ -153,7 +154,7 @@ private:
 
     FakeMachine& m_;
     int rank_;
-    Record& rec_;
+    WritersRecord& rec_;
     std::vector<TileReport> waiting_;
     std::vector<std::pair<std::uint64_t, std::uint64_t>> space_;
     std::vector<std::pair<double, AppendedTile>> writing_;  // done at, tile
@@ -163,13 +164,13 @@ using Stop = std::function<bool(int rank, double t)>;
 
 // Runs the pool on every rank of `m` with writers; rank 0 grants space in stripes of 512
 // bytes and writes its own share as it comes.
-Record run(FakeMachine& m, int ranks, std::span<const ListedTile> pending, const ScheduleSettings& settings,
+WritersRecord run(FakeMachine& m, int ranks, std::span<const ListedTile> pending, const ScheduleSettings& settings,
            const Stop& stop = {})
 {
-    Record rec(ranks);
+    WritersRecord rec(ranks);
     std::uint64_t next_free = 4096;  // past the file's own objects
     m.run([&](int rank, PoolLinks& links) {
-        FakeWork work(m, rank, rec);
+        WritersWork work(m, rank, rec);
         FakeSink sink(m, rank, rec);
         Writers writers;
         const TilesDone done = [&rec](std::span<const TileReport> tiles, int, std::span<const std::byte> payload) {
@@ -208,14 +209,7 @@ Record run(FakeMachine& m, int ranks, std::span<const ListedTile> pending, const
     return rec;
 }
 
-std::vector<ListedTile> iota(std::uint64_t n)
-{
-    std::vector<ListedTile> v(n);
-    for (std::uint64_t i = 0; i < n; ++i) v[i] = i;
-    return v;
-}
-
-void expect_recorded_once(const Record& rec, std::span<const ListedTile> pending)
+void expect_recorded_once(const WritersRecord& rec, std::span<const ListedTile> pending)
 {
     std::multiset<std::uint64_t> computed;
     for (const auto& v : rec.computed) computed.insert(v.begin(), v.end());
@@ -228,7 +222,7 @@ void expect_recorded_once(const Record& rec, std::span<const ListedTile> pending
     EXPECT_FALSE(rec.results[0].unfinished);
 }
 
-void expect_disjoint_grants(const Record& rec)
+void expect_disjoint_grants(const WritersRecord& rec)
 {
     std::vector<std::pair<std::uint64_t, std::uint64_t>> all;
     for (const auto& [writer, g] : rec.grants) all.insert(all.end(), g.begin(), g.end());
@@ -242,7 +236,7 @@ void expect_disjoint_grants(const Record& rec)
 TEST(Writers, EveryTileWrittenOnceByAsManyWritersAsAsked)
 {
     const int ranks = 32;
-    const std::vector<ListedTile> pending = iota(3000);
+    const std::vector<ListedTile> pending = listed_tiles(3000);
     const std::vector<int> each{0, 4, 8, 12, 16, 20, 24, 28}, three{0, 0, 0, 12, 12, 12, 24, 24}, one(8, 0);
     // Asked, auto from, writers, the writer of each node.
     for (const auto& [asked, auto_from, expected, writer_of_node] :
@@ -254,7 +248,7 @@ TEST(Writers, EveryTileWrittenOnceByAsManyWritersAsAsked)
         s.dedicated_root_ranks = 16;
         s.writers = asked;
         s.auto_writers_ranks = auto_from;
-        const Record rec = run(m, ranks, pending, s);
+        const WritersRecord rec = run(m, ranks, pending, s);
         expect_recorded_once(rec, pending);
         expect_disjoint_grants(rec);
         EXPECT_EQ(rec.writers(), leaders) << asked << " writers asked";
@@ -292,8 +286,8 @@ TEST(Writers, OneNodeHasOneWriter)
         FakeMachine m({.ranks = 6, .node_ranks = node_ranks});
         ScheduleSettings s;
         s.writers = 4;
-        const std::vector<ListedTile> pending = iota(500);
-        const Record rec = run(m, 6, pending, s);
+        const std::vector<ListedTile> pending = listed_tiles(500);
+        const WritersRecord rec = run(m, 6, pending, s);
         expect_recorded_once(rec, pending);
         EXPECT_EQ(rec.writers(), std::set<int>{0});
         EXPECT_EQ(rec.results[0].stats.writers, 1);
@@ -305,14 +299,14 @@ TEST(Writers, OneNodeHasOneWriter)
 TEST(Writers, StopOrLossThenResumeRecordsEveryTileOnce)
 {
     const int ranks = 12;
-    const std::vector<ListedTile> all = iota(2000);
+    const std::vector<ListedTile> all = listed_tiles(2000);
     ScheduleSettings s;
     s.report_seconds = 0.05;
     s.writers = 3;
     for (const bool lose : {false, true}) {
         FakeMachine first({.ranks = ranks, .node_ranks = 3});
         if (lose) first.lose_all_at(0.15);
-        const Record a = run(first, ranks, all, s, [&](int rank, double t) { return !lose && rank == ranks - 1 && t > 0.15; });
+        const WritersRecord a = run(first, ranks, all, s, [&](int rank, double t) { return !lose && rank == ranks - 1 && t > 0.15; });
         EXPECT_EQ(a.recorded_twice, 0u);
         EXPECT_EQ(a.recorded_unwritten, 0u);
         EXPECT_EQ(a.misplaced, 0u);
@@ -329,7 +323,7 @@ TEST(Writers, StopOrLossThenResumeRecordsEveryTileOnce)
             if (!a.recorded.contains(t)) rest.push_back(t);
         }
         FakeMachine second({.ranks = ranks, .node_ranks = 3});
-        const Record b = run(second, ranks, rest, s);
+        const WritersRecord b = run(second, ranks, rest, s);
         expect_recorded_once(b, rest);
         EXPECT_EQ(a.recorded.size() + b.recorded.size(), all.size()) << (lose ? "lost" : "stopped");
     }
