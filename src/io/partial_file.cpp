@@ -378,9 +378,8 @@ void ChunkAppender::complete(Buffer& b)
     try {
         b.write.get();
     } catch (const std::exception& e) {
-        throw h5::Error(fmt::format("writing {} compressed tiles at byte {} of {} failed ({}){}; the tiles recorded done are "
-                                    "kept: run the same command with --resume once the cause is fixed",
-                                    b.tiles.size(), b.at, file_.path().string(), e.what(), free_space_note(file_.path())));
+        throw h5::Error(fmt::format("writing {} compressed tiles at byte {} of {} failed ({}){}; {}", b.tiles.size(), b.at,
+                                    file_.path().string(), e.what(), free_space_note(file_.path()), resume_after_failure));
     }
     written_.insert(written_.end(), b.tiles.begin(), b.tiles.end());
     b.tiles.clear();
@@ -482,10 +481,8 @@ void TileWriter::complete(Buffer& b)
     try {
         b.written.get();
     } catch (const std::exception& e) {
-        throw h5::Error(fmt::format("writing tiles {} to {} to {} failed ({}){}; the tiles recorded done are kept: run "
-                                    "the same command with --resume once the cause is fixed",
-                                    b.first, b.first + b.count - 1, file_.path().string(), e.what(),
-                                    free_space_note(file_.path())));
+        throw h5::Error(fmt::format("writing tiles {} to {} to {} failed ({}){}; {}", b.first, b.first + b.count - 1,
+                                    file_.path().string(), e.what(), free_space_note(file_.path()), resume_after_failure));
     }
     written_.insert(written_.end(), b.reports.begin(), b.reports.end());
     b.reports.clear();

@@ -1,6 +1,7 @@
 #include "placed_chunks.hpp"
 
 #include "hdf5.hpp"
+#include "posix_file.hpp"
 
 #include <H5FDpublic.h>
 #include <fcntl.h>
@@ -297,8 +298,12 @@ PlacedChunks::PlacedChunks(const std::filesystem::path& path) : state_(std::make
     if (state_->undo < 0) throw h5::Error("cannot create " + undo.string() + ": " + std::strerror(errno));
     const std::uint64_t size = state_->data_end;
     if (!write_all(state_->undo, undo_magic, sizeof undo_magic, 0) || !write_all(state_->undo, &size, 8, sizeof undo_magic)) {
+        const std::string why = std::strerror(errno);
         ::close(state_->undo);
-        throw h5::Error("cannot write " + undo.string() + ": " + std::strerror(errno));
+        // Nothing of the file has changed yet: the log, unfinished, would only stand in the
+        // way of a resume (it is not an undo log a resume can read).
+        ::unlink(undo.c_str());
+        throw h5::Error("cannot write " + undo.string() + ": " + why);
     }
     const h5::Id fapl = h5::file_access(0);
     const Info info{state_.get()};
@@ -406,8 +411,15 @@ void PlacedChunks::close() { file_.close(); }
 
 void PlacedChunks::cover(const std::filesystem::path& path)
 {
-    PlacedChunks file(path);
-    file.close();
+    // A checkpoint: the file full at this moment rather than while tiles are appended says
+    // what the appender's failures say (partial_file.cpp).
+    try {
+        PlacedChunks file(path);
+        file.close();
+    } catch (const std::exception& e) {
+        throw h5::Error(fmt::format("writing the checkpoint of {} failed ({}){}; {}", path.string(), e.what(),
+                                    free_space_note(path), resume_after_failure));
+    }
     discard_undo(path);
 }
 

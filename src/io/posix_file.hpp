@@ -45,4 +45,8 @@ private:
 // system holding it is full (N bytes free)" or "...is read-only".
 std::string free_space_note(const std::filesystem::path& path);
 
+// What a failed write of the partial file leaves, said after the failure.
+inline constexpr const char* resume_after_failure =
+    "the tiles recorded done are kept: run the same command with --resume once the cause is fixed";
+
 }  // namespace superball

@@ -4,6 +4,9 @@
 // gives back the file as it was, and a tool that opens the file for writing afterwards
 // keeps the chunks.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <csignal>
 
 #include <cstdio>
 #include <filesystem>
@@ -171,6 +174,50 @@ TEST_F(PlacedChunksTest, CoveredChunksSurviveAWriterThatCutsTheFileToItsEnd)
         h5::write_attribute(file, "note", "changed");
     }
     EXPECT_GE(fs::file_size(path), size);
+}
+
+// Writes past `bytes` fail (EFBIG, as a full file system fails them with ENOSPC) while it lives.
+class FileSizeLimit {
+public:
+    explicit FileSizeLimit(rlim_t bytes)
+    {
+        getrlimit(RLIMIT_FSIZE, &old_);
+        const rlimit lower{bytes, old_.rlim_max};
+        setrlimit(RLIMIT_FSIZE, &lower);
+        old_handler_ = std::signal(SIGXFSZ, SIG_IGN);  // the write fails instead of killing the process
+    }
+    ~FileSizeLimit()
+    {
+        setrlimit(RLIMIT_FSIZE, &old_);
+        std::signal(SIGXFSZ, old_handler_);
+    }
+    FileSizeLimit(const FileSizeLimit&) = delete;
+    FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+private:
+    rlimit old_{};
+    void (*old_handler_)(int) = SIG_DFL;
+};
+
+// A checkpoint that cannot write its undo log (the file system full at that moment) changes
+// nothing, leaves no log that would stand in a resume's way, and says, as a failed append
+// does, that the tiles recorded are kept and --resume goes on.
+TEST_F(PlacedChunksTest, ACheckpointThatCannotWriteLeavesTheFileAndSaysResume)
+{
+    const std::string before = bytes_of(path);
+    std::string message;
+    {
+        const FileSizeLimit limit(0);
+        try {
+            PlacedChunks::cover(path);
+        } catch (const std::exception& e) {
+            message = e.what();
+        }
+    }
+    EXPECT_NE(message.find("writing the checkpoint of " + path.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("--resume"), std::string::npos) << message;
+    EXPECT_FALSE(fs::exists(PlacedChunks::undo_path(path)));
+    EXPECT_EQ(bytes_of(path), before);
 }
 
 }  // namespace
