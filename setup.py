@@ -44,8 +44,14 @@ class CMakeBuild(build_ext):
         tag = sysconfig.get_config_var("SOABI") or f"py{sys.version_info[0]}{sys.version_info[1]}"
         build = os.environ.get("SUPERBALL_PIP_BUILD_DIR") or os.path.join(ROOT, "build", f"pip-{tag}")
         jobs = os.environ.get("SUPERBALL_PIP_JOBS") or str(len(os.sched_getaffinity(0)))
+        # A new tree is configured for Ninja where it is installed: it compiles the libraries
+        # side by side, where Make builds them one after the other (docs/building.md). A tree
+        # configured before keeps its generator (CMake cannot change it).
+        generator = []
+        if shutil.which("ninja") and not os.path.exists(os.path.join(build, "CMakeCache.txt")):
+            generator = ["-G", "Ninja"]
         # Only what the module needs: no tests, no benchmarks.
-        subprocess.run([cmake, "-S", ROOT, "-B", build, "-DCMAKE_BUILD_TYPE=Release", f"-DPython_EXECUTABLE={sys.executable}",
+        subprocess.run([cmake, "-S", ROOT, "-B", build, *generator, "-DCMAKE_BUILD_TYPE=Release", f"-DPython_EXECUTABLE={sys.executable}",
                         "-DSUPERBALL_PYTHON_MODULE=ON", "-DSUPERBALL_TESTS=OFF", "-DSUPERBALL_BENCHMARKS=OFF"], check=True)
         subprocess.run([cmake, "--build", build, "--target", "superball_python", "-j", jobs], check=True)
         built = os.path.join(build, "python", "superball", os.path.basename(self.get_ext_filename(ext.name)))

@@ -27,14 +27,7 @@ name=$1; shift
 
 binary=${SUPERBALL:-}
 if [[ -z "$binary" ]]; then
-  "$root/.ci/install-deps"
-  build=$root/build/native
-  if [[ ! -f "$build/CMakeCache.txt" ]]; then
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DSUPERBALL_NATIVE=ON -DSUPERBALL_TESTS=OFF \
-          -DSUPERBALL_BENCHMARKS=OFF >/dev/null
-  fi
-  cmake --build "$build" -j"$(nproc)" --target superball >/dev/null
-  binary=$build/src/superball
+  binary=$(SUPERBALL_BUILD=$root/build/native "$root/jobs/build.sh")
 fi
 
 ranks=${SUPERBALL_RANKS:-$(nproc)}

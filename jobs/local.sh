@@ -18,13 +18,7 @@ fi
 job=$1; shift
 [[ -f "$job" ]] || { echo "local.sh: no job file $job" >&2; exit 2; }
 
-"$root/.ci/install-deps"
-build=${SUPERBALL_BUILD:-$root/build/native}
-if [[ ! -f "$build/CMakeCache.txt" ]]; then
-  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DSUPERBALL_NATIVE=ON -DSUPERBALL_TESTS=OFF \
-        -DSUPERBALL_BENCHMARKS=OFF >/dev/null
-fi
-cmake --build "$build" -j"$(nproc)" --target superball >/dev/null
+superball=$("$here/build.sh")
 
 ranks=${SUPERBALL_RANKS:-$(nproc)}
 mpi_flags=()
@@ -33,9 +27,9 @@ if [[ $(id -u) -eq 0 ]]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_
 (( ranks > $(nproc) )) && mpi_flags+=(--oversubscribe)
 
 # Checks the job before starting ranks, and learns where the result goes.
-output=$("$build/src/superball" explore "$job" "$@" --dry-run | sed -n 's/^output: \(.*\)$/\1/p')
+output=$("$superball" explore "$job" "$@" --dry-run | sed -n 's/^output: \(.*\)$/\1/p')
 
-mpirun -n "$ranks" "${mpi_flags[@]}" "$build/src/superball" explore "$job" "$@"
+mpirun -n "$ranks" "${mpi_flags[@]}" "$superball" explore "$job" "$@"
 
 python=/usr/bin/python3
 [[ -x $python ]] || python=python3
