@@ -48,18 +48,24 @@ ExploreSettings settings(const fs::path& out, bool resume = false, bool overwrit
     return s;
 }
 
-// Runs `job` with `s` (not resuming), stopped by rank 0 once tiles are recorded or when it
-// has been asked 1/`part` of the tiles' count times (it is asked between its tiles), then
-// resumes it: the result is `want`. The recorded tiles as well: under AddressSanitizer, 3
-// ranks with 2 writers finished every tile before rank 0 had been asked 18 times.
+// A stop rank 0 asks for once tiles are recorded or when it has been asked 1/`part` of the
+// tiles' count times (it is asked between its tiles). The recorded tiles as well: under
+// AddressSanitizer, 3 ranks with 2 writers finished every tile before rank 0 had been asked
+// 18 times (and, beside other tests, before it had been asked a tenth of the tiles' count).
+StopRequested stop_early(const Tally& first, std::uint64_t& polls, std::uint64_t part)
+{
+    return [&first, &polls, part] {
+        return world.is_root() && first.start.tiles > 0 && (first.tiles > 0 || ++polls > first.start.tiles / part);
+    };
+}
+
+// Runs `job` with `s` (not resuming), stopped early (stop_early), then resumes it: the
+// result is `want`.
 void expect_stopped_and_resumed(const Job& job, ExploreSettings s, const Data& want, std::uint64_t part)
 {
     Tally first;
     std::uint64_t polls = 0;
-    const StopRequested stop = [&] {
-        return world.is_root() && first.start.tiles > 0 && (first.tiles > 0 || ++polls > first.start.tiles / part);
-    };
-    EXPECT_TRUE(run_explore(job, s, world, first, stop).interrupted);
+    EXPECT_TRUE(run_explore(job, s, world, first, stop_early(first, polls, part)).interrupted);
     s.resume = true;
     Tally second;
     EXPECT_TRUE(run_explore(job, s, world, second, never).complete);
@@ -204,9 +210,8 @@ TEST(RunExplore, AFinishInterruptedHalfWayIsUndoneAndResumed)
     const fs::path out = dir / "undo.h5";
     Tally first;
     std::uint64_t polls = 0;
-    const StopRequested stop = [&] { return world.is_root() && first.start.tiles > 0 && ++polls > first.start.tiles / 10; };
     // The same on every rank: a failure leaves the test on every rank alike.
-    ASSERT_TRUE(run_explore(job, settings(out), world, first, stop).interrupted);
+    ASSERT_TRUE(run_explore(job, settings(out), world, first, stop_early(first, polls, 10)).interrupted);
     const fs::path partial = layout::partial_path(out);
     if (world.is_root()) {
         // What an interrupted finish leaves: some of the file's bytes overwritten, more
