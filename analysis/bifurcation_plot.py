@@ -35,7 +35,7 @@ FIXED_COLUMNS = ("branch", "period", "corner")
 VALUE_COLUMNS = ("xi", "U", "W", "lambda", "ev1_re", "ev1_im", "ev2_re", "ev2_im", "ev3_re", "ev3_im")
 TEXT_COLUMNS = ("stability", "event", "note")
 TAIL_COLUMNS = ("residual", "arclength", "bracket")
-PARAMETERS = ("e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor")
+PARAMETERS = ("e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "mu", "mu_wall", "mu_floor", "inertia")
 STABILITIES = ("stable", "unstable", "saddle", "marginal")
 # Marker of each event: (matplotlib marker, colour, label).
 EVENT_STYLE = {
@@ -43,6 +43,8 @@ EVENT_STYLE = {
     "period_doubling": ("s", "tab:purple", "period doubling"),
     "neimark_sacker": ("D", "tab:green", "Neimark-Sacker"),
     "branch_point": ("o", "tab:orange", "branch point"),
+    # SPEC.md 1b: an impact of the cycle passes from gripping to sliding.
+    "grip_slide": ("P", "tab:brown", "grip/slide (an impact starts or stops sliding)"),
     "boundary": ("X", "black", "boundary (branch leaves the region)"),
     "end": ("|", "0.4", "end"),
 }

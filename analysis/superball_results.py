@@ -191,7 +191,10 @@ def iter_blocks(shape, max_elements):
 FORMAT_VERSION = 3
 OLDEST_RESULT_FORMAT = 2
 KIND_RESULT, KIND_PARTIAL = "result", "partial"
-COEFFICIENT_NAMES = ("e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor")
+COEFFICIENT_NAMES = ("e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "mu", "mu_wall", "mu_floor", "inertia")
+# SPEC.md 1b's coefficients (results of superball 0.1.x written before them have none) and
+# their defaults: the Cross model of a solid ball.
+FRICTION_DEFAULTS = {"mu_wall": math.inf, "mu_floor": math.inf, "inertia": 0.4}
 # Limits of a sound file, as the C++ reader's (src/io/result_reader.cpp): beyond 2^40
 # points a file is damaged, not big; a job file is a few hundred bytes.
 MAX_POINTS = 1 << 40
@@ -593,7 +596,9 @@ class Result:
             self.fail("attribute complete = 1 contradicts superball_file = partial (a run in progress)")
         self._model = {}
         swept = set()
-        for key in ("e_wall", "alpha_wall", "e_floor", "alpha_floor"):
+        for key in ("e_wall", "alpha_wall", "e_floor", "alpha_floor") + tuple(FRICTION_DEFAULTS):
+            if key in FRICTION_DEFAULTS and key not in attrs:
+                continue
             if key in attrs and self._attribute(key)[0] == h5py.h5t.STRING:
                 value = self._text(key)
                 axis = value[5:] if value.startswith("axis:") else ""
@@ -603,10 +608,19 @@ class Result:
                 self._model[key] = value
                 continue
             value = self._number(key)
-            if not (0 < value <= 1 if key.startswith("e") else -1 <= value <= 1):
-                accepted = "0 < e <= 1" if key.startswith("e") else "-1 <= alpha <= 1"
+            if key.startswith("mu"):
+                ok, accepted = value >= 0, "0 <= mu <= inf"
+            elif key == "inertia":
+                ok, accepted = 0 < value <= 2 / 3, "0 < inertia <= 2/3"
+            elif key.startswith("e"):
+                ok, accepted = 0 < value <= 1, "0 < e <= 1"
+            else:
+                ok, accepted = -1 <= value <= 1, "-1 <= alpha <= 1"
+            if not ok:
                 self.fail(f"attribute {key} = {format_number(value)} is out of range: accepted {accepted}")
-            self._model[key] = value
+            # Titles name SPEC.md 1b's coefficients only where they are not the defaults.
+            if FRICTION_DEFAULTS.get(key) != value:
+                self._model[key] = value
         for name in self.axis_names:
             if name in COEFFICIENT_NAMES and name not in swept:
                 self.fail(f'attribute axis_names names the coefficient {name}, but no coefficient attribute says '

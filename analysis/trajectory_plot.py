@@ -28,7 +28,9 @@ from superball_results import (  # noqa: E402  (needs the path above)
     run_superball,
 )
 
-COLUMNS = ("event", "wall_bounces", "t", "x", "y", "u_in", "v_in", "omega_in", "u", "v", "omega")
+COLUMNS = ("event", "wall_bounces", "t", "x", "y", "u_in", "v_in", "omega_in", "u", "v", "omega", "contact", "beta")
+# The CSV of superball before SPEC.md 1b (no contact, beta): still read.
+COLUMNS_BEFORE_FRICTION = COLUMNS[:11]
 EVENT_KINDS = ("launch", "wall", "floor", "land")
 PATH_EVENT = "path"
 # Ball radius of a physical start unless --radius says otherwise (the binary's default).
@@ -78,6 +80,8 @@ class Event(NamedTuple):
     u: float
     v: float
     omega: float
+    contact: str = ""  # impacts: "grip" or "slide" (SPEC.md 1b)
+    beta: float = math.nan  # impacts: the tangential factor
 
 
 class Trajectory:
@@ -160,18 +164,20 @@ def read_csv(text, source):
     if text.lstrip().startswith("{"):
         raise ScriptError(f"{source}: this is JSON; give the CSV of `superball trajectory` (--format csv)")
     rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(text)), 1) if row and not row[0].startswith("#")]
-    if not rows or tuple(field.strip() for field in rows[0][1]) != COLUMNS:
+    header = tuple(field.strip() for field in rows[0][1]) if rows else ()
+    if header not in (COLUMNS, COLUMNS_BEFORE_FRICTION):
         raise ScriptError(f"{source}: not a superball trajectory CSV (expected the header {','.join(COLUMNS)})")
     events, path = [], []
     for line, row in rows[1:]:
-        if len(row) != len(COLUMNS):
-            raise ScriptError(f"{source} line {line}: {len(row)} fields, expected {len(COLUMNS)}")
+        if len(row) != len(header):
+            raise ScriptError(f"{source} line {line}: {len(row)} fields, expected {len(header)}")
         kind = row[0].strip()
         if kind not in EVENT_KINDS + (PATH_EVENT,):
             raise ScriptError(f"{source} line {line}: unknown event {kind!r} (expected {', '.join(EVENT_KINDS)}, path)")
         try:
-            numbers = [float(field) for field in row[2:]]
-            event = Event(kind, int(row[1]), *numbers)
+            numbers = [float(field) for field in row[2:11]]
+            contact = (row[11].strip(), float(row[12])) if len(header) == len(COLUMNS) else ()
+            event = Event(kind, int(row[1]), *numbers, *contact)
         except ValueError:
             raise ScriptError(f"{source} line {line}: a field is not a number")
         if not all(math.isfinite(value) for value in numbers):

@@ -27,7 +27,9 @@ std::string api_key(std::string_view key) { return std::string(key); }
 
 Model model_of(const Coefficients& c)
 {
-    return resolve_model({c.e, c.alpha, c.e_wall, c.alpha_wall, c.e_floor, c.alpha_floor}, api_key);
+    return resolve_model({c.e, c.alpha, c.e_wall, c.alpha_wall, c.e_floor, c.alpha_floor, c.mu, c.mu_wall, c.mu_floor,
+                          c.inertia},
+                         api_key);
 }
 
 std::uint32_t checked_max_bounces(std::uint32_t max_bounces)

@@ -20,12 +20,6 @@ std::string csv_field(const std::string& s)
     return q + "\"";
 }
 
-std::string model_text(const Model& m)
-{
-    return fmt::format("e_wall {} alpha_wall {} e_floor {} alpha_floor {}", m.wall.e, m.wall.alpha, m.floor.e,
-                       m.floor.alpha);
-}
-
 std::string start_text(const Cycle& c)
 {
     const auto& p = c.points.front();

@@ -85,8 +85,7 @@ void print_plan(const Job& job, const DryRun& d, int ranks)
             fmt::print("fixed {}: {}\n", c.name, *c.fixed);
         }
     }
-    fmt::print("model: e_wall {} alpha_wall {} e_floor {} alpha_floor {}\n", job.model.wall.e, job.model.wall.alpha,
-               job.model.floor.e, job.model.floor.alpha);
+    fmt::print("model: {}\n", model_text(job.model));
     fmt::print("points: {}\nmax_bounces: {}\n", job.points(), job.max_bounces);
     if (job.refine != 0) fmt::print("refine: coarse stride {}\n", job.refine);
     if (Grid(job).on_boundary_plane()) fmt::print("boundary plane: xi = {} (limits from inside)\n", *job.grid[0].fixed);

@@ -38,8 +38,7 @@ std::string eigenvalue_text(const std::complex<double>& z)
 void write_table(std::FILE* f, const std::vector<Cycle>& cycles, const Model& model, const FixedPointOptions& opt,
                  int ranks)
 {
-    fmt::print(f, "# superball fixed-points: e_wall {} alpha_wall {} e_floor {} alpha_floor {}\n", model.wall.e,
-               model.wall.alpha, model.floor.e, model.floor.alpha);
+    fmt::print(f, "# superball fixed-points: {}\n", model_text(model));
     fmt::print(f, "# periods 1..{}{}, {} Newton starts (seed {}) on {} rank{}: {} cycle{}\n", opt.period,
                opt.corner ? " (also on the corner plane xi = 0)" : "", opt.starts, opt.seed, ranks, ranks == 1 ? "" : "s",
                cycles.size(), cycles.size() == 1 ? "" : "s");

@@ -96,6 +96,16 @@ void add_model_flags(CLI::App& app, ModelInput& in)
     app.add_option("--alpha-wall", in.alpha_wall, "wall's alpha (overrides --alpha)")->group("Model");
     app.add_option("--e-floor", in.e_floor, "floor's e (overrides --e)")->group("Model");
     app.add_option("--alpha-floor", in.alpha_floor, "floor's alpha (overrides --alpha)")->group("Model");
+    // SPEC.md 1b: Walton's friction law and the ball's moment of inertia.
+    app.add_option("--mu", in.mu,
+                   std::string("Coulomb friction coefficient, ") + mu_range_text + "; default inf, both surfaces")
+        ->group("Model");
+    app.add_option("--mu-wall", in.mu_wall, "wall's mu (overrides --mu)")->group("Model");
+    app.add_option("--mu-floor", in.mu_floor, "floor's mu (overrides --mu)")->group("Model");
+    app.add_option("--inertia", in.inertia,
+                   std::string("the ball's moment of inertia over m a^2, ") + inertia_range_text +
+                       "; default 0.4, a solid ball")
+        ->group("Model");
 }
 
 void add_start_flags(CLI::App& app, StartInput& in)

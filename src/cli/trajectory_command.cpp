@@ -16,8 +16,8 @@ void write_csv(std::FILE* f, const Trajectory& tr, double radius)
 {
     fmt::print(f, "{}\n", trajectory_columns);
     for (const TrajectoryRow& r : trajectory_rows(tr, radius)) {
-        fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", r.event, r.wall_bounces, r.t, r.x, r.y, r.u_in, r.v_in, r.omega_in,
-                   r.u, r.v, r.omega);
+        fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{}\n", r.event, r.wall_bounces, r.t, r.x, r.y, r.u_in, r.v_in,
+                   r.omega_in, r.u, r.v, r.omega, r.contact, r.beta);
     }
 }
 

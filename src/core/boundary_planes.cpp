@@ -10,10 +10,11 @@ namespace {
 // -1 for the representative v = 1, g = 1 of canonical_map). See boundary_planes.md.
 PlaneStep plane_map(double v_w, double U, double W, const ModelMatrices& m)
 {
-    const Velocities<double> after_wall = wall_impact(Velocities<double>{U, v_w, W}, m.wall);
+    const Velocities<double> after_wall = walton_wall_impact(Velocities<double>{U, v_w, W}, m.wall);
     const double p = after_wall.v;
     // From height 0 the ball is back on the floor with vertical speed |p|.
-    const Velocities<double> after_floor = floor_impact(Velocities<double>{after_wall.u, -std::fabs(p), after_wall.W}, m.floor);
+    const Velocities<double> after_floor =
+        walton_floor_impact(Velocities<double>{after_wall.u, -std::fabs(p), after_wall.W}, m.floor);
     PlaneStep r;
     r.p = p;
     r.lambda = after_floor.v;

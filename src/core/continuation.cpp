@@ -43,11 +43,42 @@ constexpr int location_corrector_iterations = 60;
 // circle.
 constexpr double confirmation_tolerance = 1e-6;
 
-bool surface_parameter(Parameter p, bool wall, bool e)
+// Which coefficient of a surface a parameter sets.
+enum class Kind : std::uint8_t { e, alpha, mu, inertia };
+
+Kind kind_of(Parameter p)
 {
-    if (e) return p == Parameter::e || p == (wall ? Parameter::e_wall : Parameter::e_floor);
-    return p == Parameter::alpha || p == (wall ? Parameter::alpha_wall : Parameter::alpha_floor);
+    switch (p) {
+        case Parameter::e:
+        case Parameter::e_wall:
+        case Parameter::e_floor: return Kind::e;
+        case Parameter::alpha:
+        case Parameter::alpha_wall:
+        case Parameter::alpha_floor: return Kind::alpha;
+        case Parameter::mu:
+        case Parameter::mu_wall:
+        case Parameter::mu_floor: return Kind::mu;
+        case Parameter::inertia: return Kind::inertia;
+    }
+    return Kind::e;
 }
+
+// Whether the parameter sets the wall's (floor's) coefficient: the shared ones set both.
+bool sets_surface(Parameter p, bool wall)
+{
+    switch (p) {
+        case Parameter::e_wall:
+        case Parameter::alpha_wall:
+        case Parameter::mu_wall: return wall;
+        case Parameter::e_floor:
+        case Parameter::alpha_floor:
+        case Parameter::mu_floor: return !wall;
+        case Parameter::inertia: return false;
+        default: return true;
+    }
+}
+
+double& coefficient(Surface& s, Kind k) { return k == Kind::e ? s.e : k == Kind::alpha ? s.alpha : s.mu; }
 
 // The impact matrices along the path at s = value, each coefficient carrying its
 // derivative in s (the fourth independent variable).
@@ -58,10 +89,13 @@ BasicModelMatrices<Dual4> dual_matrices(const ParameterPath& path, double value)
         c.derivatives()(3) = direction;
         return c;
     };
+    const Dual4 inertia = coefficient(path.origin.inertia, path.direction.inertia);
     const auto matrix = [&](const Surface& o, const Surface& d) {
-        return BasicImpactMatrix<Dual4>::of(coefficient(o.e, d.e), coefficient(o.alpha, d.alpha));
+        return BasicImpactMatrix<Dual4>::of(coefficient(o.e, d.e), coefficient(o.alpha, d.alpha), inertia,
+                                            coefficient(o.mu, d.mu));
     };
-    return {matrix(path.origin.wall, path.direction.wall), matrix(path.origin.floor, path.direction.floor)};
+    return {matrix(path.origin.wall, path.direction.wall), matrix(path.origin.floor, path.direction.floor),
+            path.at(value).frictional()};
 }
 
 CanonicalState<double> value_of(const CanonicalState<Dual4>& c) { return {c.xi.value(), c.U.value(), c.W.value()}; }
@@ -238,6 +272,8 @@ enum class TestKind : std::uint8_t {
     period_doubling,
     neimark_sacker,
     kappa,        // corner plane: transverse multiplier - 1
+    wall_grip,    // psi* - psi of the wall impact from cycle point `point` (SPEC.md 1b)
+    floor_grip,   // the same of its floor impact
     xi_zero,      // xi of cycle point `point`
     xi_one,       // 1 - xi
     U_zero,       // -U
@@ -266,6 +302,8 @@ std::vector<Test> tests_of(const System& sys)
         }
         tests.push_back({TestKind::U_zero, i});
         if (sys.corner) tests.push_back({TestKind::wall_down, i});
+        tests.push_back({TestKind::wall_grip, i});
+        tests.push_back({TestKind::floor_grip, i});
     }
     tests.push_back({TestKind::lower_bound});
     tests.push_back({TestKind::upper_bound});
@@ -294,6 +332,14 @@ double test_value(const System& sys, const Test& test, const Node& n, const Cont
         case TestKind::xi_zero: return point().xi;
         case TestKind::xi_one: return 1.0 - point().xi;
         case TestKind::U_zero: return -point().U;
+        case TestKind::wall_grip:
+        case TestKind::floor_grip: {
+            // An infinite mu: inf, never a sign change.
+            const ModelMatrices m = ModelMatrices::of(sys.path.at(n.y(3)));
+            const ImpactContacts ic = impact_contacts(point(), m);
+            if (test.kind == TestKind::wall_grip) return m.wall.grip_ratio - std::abs(ic.s_wall) / ic.approach_wall;
+            return m.floor.grip_ratio - std::abs(ic.s_floor) / ic.approach_floor;
+        }
         case TestKind::wall_down: {
             const ModelMatrices m = ModelMatrices::of(sys.path.at(n.y(3)));
             return -plane_map_xi0(point().U, point().W, m).p;
@@ -418,8 +464,14 @@ std::string boundary_note(TestKind k)
 // the event; nullopt when the eigenvalues do not confirm it (the test function changed sign
 // through a pole, where G^k is singular, or at a neutral saddle, mu_i mu_j = 1 for a real
 // pair).
-std::optional<std::pair<BranchEvent, std::string>> classify_event(TestKind kind, const Node& n)
+std::optional<std::pair<BranchEvent, std::string>> classify_event(const Test& test, const Node& n)
 {
+    const TestKind kind = test.kind;
+    if (kind == TestKind::wall_grip || kind == TestKind::floor_grip) {
+        return std::pair{BranchEvent::grip_slide, std::string(kind == TestKind::wall_grip ? "wall" : "floor") +
+                                                      " impact after point " + std::to_string(test.point) +
+                                                      " of the cycle: psi = psi*, grips on one side, slides on the other"};
+    }
     const auto ev = sorted_eigenvalues(n.ev.g.dG);
     if (!ev) return std::nullopt;
     const auto has_eigenvalue = [&](double mu) {
@@ -518,7 +570,7 @@ std::vector<Located> sign_changes(const Context& c, const Direction& d, const st
         const double step_h = (i == ia ? h : d.arclength[i + 1] - d.arclength[i]);
         const double f_to = i == ia ? vb[j] : values[i + 1][j];
         Position where = locate(c, j, from, step_h, fa, to, f_to);
-        auto what = classify_event(c.tests[j].kind, where.node);
+        auto what = classify_event(c.tests[j], where.node);
         if (!what) continue;
         if (where.bracket > location_tolerance * (1.0 + step_h)) what->second += unlocated_note;
         found.push_back({std::move(where.node), i, where.h, what->first, std::move(what->second), where.bracket});
@@ -663,6 +715,10 @@ std::string_view name(Parameter p)
         case Parameter::alpha_wall: return "alpha_wall";
         case Parameter::e_floor: return "e_floor";
         case Parameter::alpha_floor: return "alpha_floor";
+        case Parameter::mu: return "mu";
+        case Parameter::mu_wall: return "mu_wall";
+        case Parameter::mu_floor: return "mu_floor";
+        case Parameter::inertia: return "inertia";
     }
     return "unknown";
 }
@@ -677,23 +733,21 @@ std::optional<Parameter> parameter_named(std::string_view text)
 
 double parameter_value(const Model& m, Parameter p)
 {
-    switch (p) {
-        case Parameter::e:
-        case Parameter::e_wall: return m.wall.e;
-        case Parameter::alpha:
-        case Parameter::alpha_wall: return m.wall.alpha;
-        case Parameter::e_floor: return m.floor.e;
-        case Parameter::alpha_floor: return m.floor.alpha;
-    }
-    return 0.0;
+    const Kind k = kind_of(p);
+    if (k == Kind::inertia) return m.inertia;
+    Surface s = sets_surface(p, true) ? m.wall : m.floor;  // e, alpha, mu: the wall's
+    return coefficient(s, k);
 }
 
 Model with_parameter(Model m, Parameter p, double value)
 {
-    if (surface_parameter(p, true, true)) m.wall.e = value;
-    if (surface_parameter(p, false, true)) m.floor.e = value;
-    if (surface_parameter(p, true, false)) m.wall.alpha = value;
-    if (surface_parameter(p, false, false)) m.floor.alpha = value;
+    const Kind k = kind_of(p);
+    if (k == Kind::inertia) {
+        m.inertia = value;
+        return m;
+    }
+    if (sets_surface(p, true)) coefficient(m.wall, k) = value;
+    if (sets_surface(p, false)) coefficient(m.floor, k) = value;
     return m;
 }
 
@@ -701,30 +755,45 @@ bool parameter_defined(const Model& m, Parameter p)
 {
     if (p == Parameter::e) return m.wall.e == m.floor.e;
     if (p == Parameter::alpha) return m.wall.alpha == m.floor.alpha;
+    if (p == Parameter::mu) return m.wall.mu == m.floor.mu;
     return true;
 }
 
 bool parameter_in_range(Parameter p, double value)
 {
-    const bool e = p == Parameter::e || p == Parameter::e_wall || p == Parameter::e_floor;
-    return e ? e_in_range(value) : alpha_in_range(value);
+    switch (kind_of(p)) {
+        case Kind::e: return e_in_range(value);
+        case Kind::alpha: return alpha_in_range(value);
+        case Kind::mu: return mu_in_range(value);
+        case Kind::inertia: return inertia_in_range(value);
+    }
+    return false;
 }
 
 const char* parameter_range_text(Parameter p)
 {
-    const bool e = p == Parameter::e || p == Parameter::e_wall || p == Parameter::e_floor;
-    return e ? e_range_text : alpha_range_text;
+    switch (kind_of(p)) {
+        case Kind::e: return e_range_text;
+        case Kind::alpha: return alpha_range_text;
+        case Kind::mu: return mu_range_text;
+        case Kind::inertia: return inertia_range_text;
+    }
+    return "";
 }
 
 Model ParameterPath::at(double s) const
 {
-    const auto surface = [s](const Surface& o, const Surface& d) { return Surface{o.e + s * d.e, o.alpha + s * d.alpha}; };
-    return {surface(origin.wall, direction.wall), surface(origin.floor, direction.floor)};
+    // An infinite mu stays infinite (its rate is 0 unless mu is the parameter).
+    const auto surface = [s](const Surface& o, const Surface& d) {
+        return Surface{o.e + s * d.e, o.alpha + s * d.alpha, d.mu == 0.0 ? o.mu : o.mu + s * d.mu};
+    };
+    return {surface(origin.wall, direction.wall), surface(origin.floor, direction.floor),
+            origin.inertia + s * direction.inertia};
 }
 
 ParameterPath ParameterPath::along(const Model& model, Parameter p)
 {
-    ParameterPath path{with_parameter(model, p, 0.0), with_parameter(Model{{0.0, 0.0}, {0.0, 0.0}}, p, 1.0),
+    ParameterPath path{with_parameter(model, p, 0.0), with_parameter(no_change, p, 1.0),
                        std::string(superball::name(p))};
     return path;
 }
@@ -769,6 +838,7 @@ std::string_view name(BranchEvent e)
         case BranchEvent::branch_point: return "branch_point";
         case BranchEvent::boundary: return "boundary";
         case BranchEvent::end: return "end";
+        case BranchEvent::grip_slide: return "grip_slide";
     }
     return "unknown";
 }

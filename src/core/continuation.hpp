@@ -29,6 +29,9 @@
 //   neimark_sacker   det(D(G^k) (.) D(G^k) - I), the bialternate product whose eigenvalues
 //                    are mu_i mu_j - 1: reported when a complex pair is on the unit circle
 //                    there (a real pair with mu_i mu_j = 1, a neutral saddle, is no event)
+//   grip_slide       psi* - psi of the wall or floor impact of some point of the cycle
+//                    (SPEC.md 1b: psi = |contact velocity| / approach speed, psi* the
+//                    largest that grips): the impact passes from gripping to sliding
 //   boundary         xi, 1 - xi or -U of some point of the cycle through 0: the branch
 //                    leaves the region where G is the motion; it stops there
 //   end              the parameter bound (the last point is solved at p = bound exactly),
@@ -55,12 +58,13 @@
 
 namespace superball {
 
-// The coefficient continued in: e and alpha set both surfaces (which must then agree).
-enum class Parameter : std::uint8_t { e, alpha, e_wall, alpha_wall, e_floor, alpha_floor };
+// The coefficient continued in: e, alpha and mu set both surfaces (which must then agree);
+// mu and inertia are SPEC.md 1b's.
+enum class Parameter : std::uint8_t { e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall, mu_floor, inertia };
 
-inline constexpr std::array<Parameter, 6> all_parameters{Parameter::e,       Parameter::alpha,
-                                                         Parameter::e_wall,  Parameter::alpha_wall,
-                                                         Parameter::e_floor, Parameter::alpha_floor};
+inline constexpr std::array<Parameter, 10> all_parameters{
+    Parameter::e,           Parameter::alpha, Parameter::e_wall,  Parameter::alpha_wall, Parameter::e_floor,
+    Parameter::alpha_floor, Parameter::mu,    Parameter::mu_wall, Parameter::mu_floor,   Parameter::inertia};
 
 std::string_view name(Parameter p);
 std::optional<Parameter> parameter_named(std::string_view name);
@@ -75,7 +79,11 @@ bool parameter_defined(const Model& m, Parameter p);
 bool parameter_in_range(Parameter p, double value);
 const char* parameter_range_text(Parameter p);
 
-// A line in the space of the four coefficients: coefficients(s) = origin + s direction.
+// The direction that changes no coefficient (not Model{}: a Model's defaults are a ball's,
+// mu infinite and inertia 2/5).
+inline constexpr Model no_change{{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0.0};
+
+// A line in the space of the coefficients: coefficients(s) = origin + s direction.
 // Continuation in one coefficient follows the line along it (s is its value); an event
 // curve in two coefficients is found on lines across it (continue_event).
 struct ParameterPath {
@@ -104,7 +112,9 @@ ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const Mode
 // The same with the derivative along a path of coefficients, at path.at(value).
 ParameterJacobian parameter_jacobian(const CanonicalState<double>& s, const ParameterPath& path, double value, int k);
 
-enum class BranchEvent : std::uint8_t { none, fold, period_doubling, neimark_sacker, branch_point, boundary, end };
+// grip_slide (SPEC.md 1b): an impact of the cycle passes from gripping to sliding, where
+// G^k is continuous but its Jacobian jumps (a border-collision bifurcation).
+enum class BranchEvent : std::uint8_t { none, fold, period_doubling, neimark_sacker, branch_point, boundary, end, grip_slide };
 
 std::string_view name(BranchEvent e);
 

@@ -16,6 +16,7 @@ std::optional<Outcome> outcome_from_name(std::string_view s)
 namespace {
 
 // The loop of SPEC.md section 3 from state c after n wall impacts.
+template <ImpactLaw law>
 BounceCount iterate(CanonicalState<double> c, std::uint32_t n, const ModelMatrices& m, std::uint32_t max_bounces)
 {
     for (;;) {
@@ -24,13 +25,21 @@ BounceCount iterate(CanonicalState<double> c, std::uint32_t n, const ModelMatric
         // Capped means the ball would hit the wall once more: a ball whose next
         // excursion misses is reported as missed even at the cap.
         if (n >= max_bounces) return {n, Outcome::capped};
-        const CanonicalStep<double> step = canonical_map(c, m);
+        const CanonicalStep<double> step = canonical_map<law>(c, m);
         // Overflow or division by zero (map.hpp, representable): no answer, not a miss.
         if (!representable(step)) return {0, Outcome::invalid};
         c = step.next;
         ++n;
         if (c.U >= 0.0) return {n, Outcome::left};
     }
+}
+
+// Without friction every impact grips: the Cross model's arithmetic alone (the same bits as
+// Walton's law with infinite mu, without computing the friction limit).
+BounceCount iterate(const CanonicalState<double>& c, std::uint32_t n, const ModelMatrices& m, std::uint32_t max_bounces)
+{
+    if (m.frictional) return iterate<ImpactLaw::walton>(c, n, m, max_bounces);
+    return iterate<ImpactLaw::cross>(c, n, m, max_bounces);
 }
 
 }  // namespace

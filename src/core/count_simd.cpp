@@ -86,10 +86,11 @@ struct Stepped {
 
 // G applied to a batch: the exits of SPEC.md section 3 after the step, in the order
 // count() checks them (invalid takes precedence over left over missed over capped).
+template <ImpactLaw law>
 [[gnu::always_inline]] inline void step(const CanonicalState<Batch>& c, const Batch& count, const ModelMatrices& m,
                                         double max_bounces, Stepped& next, std::size_t i)
 {
-    const CanonicalStep<Batch> s = canonical_map(c, m);
+    const CanonicalStep<Batch> s = canonical_map<law>(c, m);
     Batch exit = go_on;
     stdx::where(count >= max_bounces, exit) = code(Outcome::capped);
     stdx::where(!(s.next.xi < 1.0), exit) = code(Outcome::missed);
@@ -142,6 +143,7 @@ void settle(const Stepped& next, std::size_t n, const std::size_t* point, Live& 
 // bookkeeping point by point: kept apart, each loop is short enough for the processor to
 // overlap many batches; interleaved, every batch waited on its own divisions and square
 // root.
+template <ImpactLaw law>
 void first_sweep(const simd_variant::Arrays& in, std::size_t first, std::size_t n, const ModelMatrices& m,
                  double max_bounces, Stepped& next, Live& live, std::size_t* index)
 {
@@ -165,7 +167,7 @@ void first_sweep(const simd_variant::Arrays& in, std::size_t first, std::size_t 
             c = {Batch(part[0], stdx::vector_aligned), Batch(part[1], stdx::vector_aligned),
                  Batch(part[2], stdx::vector_aligned)};
         }
-        step(c, Batch(1.0), m, max_bounces, next, i);
+        step<law>(c, Batch(1.0), m, max_bounces, next, i);
         Batch before = go_on;  // decided before any excursion, with 0 impacts
         stdx::where(!(c.xi < 1.0), before) = code(Outcome::missed);
         // is_launch() as plain compares (NaN fails each): finite xi > 0, finite U < 0, finite W.
@@ -185,12 +187,13 @@ void first_sweep(const simd_variant::Arrays& in, std::size_t first, std::size_t 
 }
 
 // One more excursion for every live point.
+template <ImpactLaw law>
 void sweep(Live& live, Stepped& next, const ModelMatrices& m, double max_bounces, const simd_variant::Arrays& out)
 {
     for (std::size_t i = 0; i < live.size; i += width) {
         const CanonicalState<Batch> c{Batch(&live.xi[i], stdx::vector_aligned), Batch(&live.U[i], stdx::vector_aligned),
                                       Batch(&live.W[i], stdx::vector_aligned)};
-        step(c, Batch(&live.n[i], stdx::vector_aligned) + 1.0, m, max_bounces, next, i);
+        step<law>(c, Batch(&live.n[i], stdx::vector_aligned) + 1.0, m, max_bounces, next, i);
     }
     const std::size_t n = live.size;
     live.size = 0;
@@ -198,9 +201,8 @@ void sweep(Live& live, Stepped& next, const ModelMatrices& m, double max_bounces
     settle(next, n, live.point, live, out);
 }
 
-}  // namespace
-
-void count_each(const simd_variant::Arrays& points, const ModelMatrices& m, std::uint32_t max_bounces)
+template <ImpactLaw law>
+void count_blocks(const simd_variant::Arrays& points, const ModelMatrices& m, std::uint32_t max_bounces)
 {
     Live live;
     Stepped next;
@@ -215,9 +217,19 @@ void count_each(const simd_variant::Arrays& points, const ModelMatrices& m, std:
     const auto cap = static_cast<double>(max_bounces);
     for (std::size_t first = 0; first < points.size; first += block) {
         const std::size_t n = points.size - first < block ? points.size - first : block;
-        first_sweep(points, first, n, m, cap, next, live, index);
-        while (live.size > 0) sweep(live, next, m, cap, points);
+        first_sweep<law>(points, first, n, m, cap, next, live, index);
+        while (live.size > 0) sweep<law>(live, next, m, cap, points);
     }
+}
+
+}  // namespace
+
+// Without friction every impact grips: the Cross model's arithmetic alone, the same bits as
+// Walton's law with infinite mu without computing the friction limit (the kernel's speed).
+void count_each(const simd_variant::Arrays& points, const ModelMatrices& m, std::uint32_t max_bounces)
+{
+    if (m.frictional) count_blocks<ImpactLaw::walton>(points, m, max_bounces);
+    else count_blocks<ImpactLaw::cross>(points, m, max_bounces);
 }
 
 const char* instruction_set()

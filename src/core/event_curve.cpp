@@ -24,7 +24,7 @@ struct Plane {
 // Coefficients (q1, q2) + s (n1, n2), the others those of the model.
 ParameterPath line(const Plane& plane, double q1, double q2, double n1, double n2)
 {
-    const Model zero{{0.0, 0.0}, {0.0, 0.0}};
+    const Model zero = no_change;
     return {with_parameter(with_parameter(plane.model, plane.first, q1), plane.second, q2),
             with_parameter(with_parameter(zero, plane.first, n1), plane.second, n2), "s"};
 }
@@ -168,7 +168,7 @@ EventCurvePoint curve_point(const Found& f)
 
 bool independent(Parameter a, Parameter b)
 {
-    const Model zero{{0.0, 0.0}, {0.0, 0.0}};
+    const Model zero = no_change;
     const Model ma = with_parameter(zero, a, 1.0), mb = with_parameter(zero, b, 1.0);
     return ma.wall.e * mb.wall.e + ma.wall.alpha * mb.wall.alpha + ma.floor.e * mb.floor.e +
                ma.floor.alpha * mb.floor.alpha ==

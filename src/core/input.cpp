@@ -15,6 +15,18 @@ std::string format_double(double x)
     return {buf, r.ptr};
 }
 
+std::string model_text(const Model& m)
+{
+    std::string out = "e_wall " + format_double(m.wall.e) + " alpha_wall " + format_double(m.wall.alpha) + " e_floor " +
+                      format_double(m.floor.e) + " alpha_floor " + format_double(m.floor.alpha);
+    const Model defaults{};
+    if (m.wall.mu != defaults.wall.mu || m.floor.mu != defaults.floor.mu) {
+        out += " mu_wall " + format_double(m.wall.mu) + " mu_floor " + format_double(m.floor.mu);
+    }
+    if (m.inertia != defaults.inertia) out += " inertia " + format_double(m.inertia);
+    return out;
+}
+
 std::string quote(std::string_view s)
 {
     std::string out = "\"";
@@ -39,18 +51,27 @@ std::string quote(std::string_view s)
 
 namespace {
 
+// What a coefficient accepts, for the range check and its message.
+struct Accepted {
+    bool (*in_range)(double);
+    const char* text;
+};
+
+// A surface's coefficient: the per-surface key's value, else the shared key's, else
+// `fallback` (none: the coefficient must be given).
 double pick(const std::optional<double>& specific, const std::optional<double>& shared, std::string_view key,
-            std::string_view shared_key, bool is_e, const KeySpelling& spell)
+            std::string_view shared_key, Accepted accepted, const KeySpelling& spell,
+            std::optional<double> fallback = std::nullopt)
 {
     const bool from_specific = specific.has_value();
     if (!from_specific && !shared) {
+        if (fallback) return *fallback;
         throw InputError(spell(key) + " is not set: give " + spell(shared_key) + " (both surfaces) or " + spell(key));
     }
     const double value = from_specific ? *specific : *shared;
-    const bool ok = is_e ? e_in_range(value) : alpha_in_range(value);
-    if (!ok) {
+    if (!accepted.in_range(value)) {
         throw InputError(spell(from_specific ? key : shared_key) + " = " + format_double(value) +
-                         " is out of range: accepted " + (is_e ? e_range_text : alpha_range_text));
+                         " is out of range: accepted " + accepted.text);
     }
     return value;
 }
@@ -73,9 +94,17 @@ void check_launch(bool ok, std::string_view key, double value, std::string_view 
 
 Model resolve_model(const ModelInput& in, const KeySpelling& spell)
 {
-    return {{pick(in.e_wall, in.e, "e_wall", "e", true, spell), pick(in.alpha_wall, in.alpha, "alpha_wall", "alpha", false, spell)},
-            {pick(in.e_floor, in.e, "e_floor", "e", true, spell),
-             pick(in.alpha_floor, in.alpha, "alpha_floor", "alpha", false, spell)}};
+    constexpr Accepted e{e_in_range, e_range_text}, alpha{alpha_in_range, alpha_range_text}, mu{mu_in_range, mu_range_text};
+    const Surface defaults{};
+    const Surface wall{pick(in.e_wall, in.e, "e_wall", "e", e, spell),
+                       pick(in.alpha_wall, in.alpha, "alpha_wall", "alpha", alpha, spell),
+                       pick(in.mu_wall, in.mu, "mu_wall", "mu", mu, spell, defaults.mu)};
+    const Surface floor{pick(in.e_floor, in.e, "e_floor", "e", e, spell),
+                        pick(in.alpha_floor, in.alpha, "alpha_floor", "alpha", alpha, spell),
+                        pick(in.mu_floor, in.mu, "mu_floor", "mu", mu, spell, defaults.mu)};
+    const double inertia = pick(in.inertia, std::nullopt, "inertia", "inertia", {inertia_in_range, inertia_range_text},
+                                spell, solid_ball_inertia);
+    return {wall, floor, inertia};
 }
 
 StartKind resolve_start_keys(const StartInput& in, const KeySpelling& spell)

@@ -20,10 +20,26 @@ struct InputError : std::invalid_argument {
     using std::invalid_argument::invalid_argument;
 };
 
-// The coefficients as given: `e` and `alpha` set both surfaces, per-surface keys override.
+// The coefficients as given: `e`, `alpha` and `mu` set both surfaces, per-surface keys
+// override. mu (SPEC.md 1b) defaults to infinite and inertia to 2/5: the Cross model of a
+// solid ball.
 struct ModelInput {
     std::optional<double> e, alpha, e_wall, alpha_wall, e_floor, alpha_floor;
+    // Initialised, so that aggregates written before them ({e, alpha}) need not name them.
+    std::optional<double> mu = std::nullopt, mu_wall = std::nullopt, mu_floor = std::nullopt, inertia = std::nullopt;
 };
+
+// The keys of ModelInput by name, in the order the interfaces list them: what a query, a
+// dict or a job's [model] table may hold.
+struct ModelKey {
+    const char* name;
+    std::optional<double> ModelInput::*member;
+};
+inline constexpr ModelKey model_input_keys[] = {
+    {"e", &ModelInput::e},           {"alpha", &ModelInput::alpha},           {"e_wall", &ModelInput::e_wall},
+    {"alpha_wall", &ModelInput::alpha_wall}, {"e_floor", &ModelInput::e_floor}, {"alpha_floor", &ModelInput::alpha_floor},
+    {"mu", &ModelInput::mu},         {"mu_wall", &ModelInput::mu_wall},       {"mu_floor", &ModelInput::mu_floor},
+    {"inertia", &ModelInput::inertia}};
 
 // Spells a key the way the user wrote it: "e_wall" for job files, "--e-wall" on the
 // command line.
@@ -81,6 +97,11 @@ OneStartSetup resolve_one_start(const ModelInput& model, const StartInput& start
 
 // Shortest text that reads back as the same double (for messages and attributes).
 std::string format_double(double x);
+
+// The model as the commands print it: "e_wall 0.9 alpha_wall 0.9 e_floor 0.9 alpha_floor
+// 0.9", followed by "mu_wall 1 mu_floor 1 inertia 0.5" where SPEC.md 1b's coefficients are
+// not their defaults (so that the Cross model of a solid ball prints as it always did).
+std::string model_text(const Model& m);
 
 // `s` in double quotes with \" \\ \n \t and \u00XX escapes: a JSON string and a TOML basic
 // string alike (for messages that quote user text, and JSON output).

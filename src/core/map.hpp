@@ -6,7 +6,6 @@
 #pragma once
 
 #include <cmath>
-#include <experimental/simd>
 #include <limits>
 
 #include "impact.hpp"
@@ -22,22 +21,6 @@ template <class T>
 auto root(const T& x)
 {
     return sqrt(x);
-}
-
-// cond ? a : b, lane by lane for SIMD batches. Both branches are computed.
-inline double choose(bool cond, double a, double b) { return cond ? a : b; }
-// Other scalar number types (automatic differentiation in dynamics.hpp).
-template <class T>
-T choose(bool cond, const T& a, const T& b)
-{
-    return cond ? a : b;
-}
-template <class T, class Abi>
-std::experimental::simd<T, Abi> choose(const typename std::experimental::simd<T, Abi>::mask_type& cond,
-                                       std::experimental::simd<T, Abi> a, const std::experimental::simd<T, Abi>& b)
-{
-    std::experimental::where(!cond, a) = b;
-    return a;
 }
 }  // namespace detail
 
@@ -89,13 +72,14 @@ struct Excursion {
 
 // One excursion n -> n+1 in physical variables. Valid when the wall is reached
 // (to_wall.y > 0); the caller decides what a miss means.
-template <class T>
+// `law`: ImpactLaw::walton everywhere but in the counting kernels' fast path (impact.hpp).
+template <ImpactLaw law = ImpactLaw::walton, class T>
 constexpr Excursion<T> excursion(const PhysicalState<T>& s, const ModelMatrices& m, double g)
 {
     const WallArrival<T> w = flight_to_wall(s, g);
-    const Velocities<T> after_wall = wall_impact(Velocities<T>{s.u, w.v_w, s.W}, m.wall);
+    const Velocities<T> after_wall = impact_at_wall<law>(Velocities<T>{s.u, w.v_w, s.W}, m.wall);
     const FloorArrival<T> f = flight_to_floor(after_wall, w.y, g);
-    const Velocities<T> after_floor = floor_impact(Velocities<T>{after_wall.u, f.v_f, after_wall.W}, m.floor);
+    const Velocities<T> after_floor = impact_at_floor<law>(Velocities<T>{after_wall.u, f.v_f, after_wall.W}, m.floor);
     return {w, after_wall, f, {f.x, after_floor.u, after_floor.v, after_floor.W}};
 }
 
@@ -121,18 +105,35 @@ struct CanonicalStep {
 // relative precision near the boundary planes xi -> 0 and xi -> 1. Valid for xi < 1;
 // xi' is meaningful when U' < 0.
 // S: the coefficients' number type (double; in continuation, a differentiated parameter).
-template <class T, class S>
+// law: which impacts (impact.hpp); walton but in the counting kernels' path for a model
+// without friction.
+template <ImpactLaw law = ImpactLaw::walton, class T, class S>
 constexpr CanonicalStep<T> canonical_map(const CanonicalState<T>& c, const BasicModelMatrices<S>& m)
 {
     const T t_wall = 2.0 * c.xi;
     const T y = t_wall * (1.0 - c.xi);
-    const Velocities<T> after_wall = wall_impact(Velocities<T>{c.U, 1.0 - t_wall, c.W}, m.wall);
+    const Velocities<T> after_wall = impact_at_wall<law>(Velocities<T>{c.U, 1.0 - t_wall, c.W}, m.wall);
     const FloorArrival<T> f = flight_to_floor(after_wall, y, 1.0);
-    const Velocities<T> after_floor = floor_impact(Velocities<T>{after_wall.u, f.v_f, after_wall.W}, m.floor);
+    const Velocities<T> after_floor = impact_at_floor<law>(Velocities<T>{after_wall.u, f.v_f, after_wall.W}, m.floor);
     const T lambda = after_floor.v;
     const T U = after_floor.u / lambda;
     // xi' = g x' / (2 |u'| v') with g = 1; |u'| = -u' on the branch where it matters.
     return {{f.x / (-2.0 * after_floor.u * lambda), U, after_floor.W / lambda}, lambda};
+}
+
+// What decides whether each impact of G's excursion from c slides (SPEC.md 1b): the contact
+// velocity s and the approach speed v_n at the wall and at the floor, for the representative
+// v = 1, g = 1 (psi = |s| / v_n is the same for every representative).
+struct ImpactContacts {
+    double s_wall, approach_wall, s_floor, approach_floor;
+};
+
+inline ImpactContacts impact_contacts(const CanonicalState<double>& c, const ModelMatrices& m)
+{
+    const double v_w = 1.0 - 2.0 * c.xi;
+    const Velocities<double> after_wall = walton_wall_impact(Velocities<double>{c.U, v_w, c.W}, m.wall);
+    const FloorArrival<double> f = flight_to_floor(after_wall, 2.0 * c.xi * (1.0 - c.xi), 1.0);
+    return {v_w - c.W, -c.U, after_wall.u + after_wall.W, -f.v_f};
 }
 
 // Whether a step of G stayed within double precision: the multiplier is positive and

@@ -63,11 +63,14 @@ Trajectory trajectory(const PhysicalState<double>& start, const Model& model, do
             const Excursion<double> e = excursion(s, m, g);
             flight(e.to_wall.t);
             t += e.to_wall.t;
-            out.events.push_back({EventKind::wall, n, t, 0.0, e.to_wall.y, {s.u, e.to_wall.v_w, s.W}, e.after_wall});
+            const Velocities<double> at_wall{s.u, e.to_wall.v_w, s.W};
+            out.events.push_back({EventKind::wall, n, t, 0.0, e.to_wall.y, at_wall, e.after_wall,
+                                  contact(at_wall.v - at_wall.W, -at_wall.u, model.wall.alpha, m.wall)});
             flight(e.to_floor.t);
             t += e.to_floor.t;
-            out.events.push_back({EventKind::floor, n, t, e.next.x, 0.0,
-                                  {e.after_wall.u, e.to_floor.v_f, e.after_wall.W}, {e.next.u, e.next.v, e.next.W}});
+            const Velocities<double> at_floor{e.after_wall.u, e.to_floor.v_f, e.after_wall.W};
+            out.events.push_back({EventKind::floor, n, t, e.next.x, 0.0, at_floor, {e.next.u, e.next.v, e.next.W},
+                                  contact(at_floor.u + at_floor.W, -at_floor.v, model.floor.alpha, m.floor)});
             s = e.next;
         }
         c = canonical_map(c, m).next;

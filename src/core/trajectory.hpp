@@ -34,6 +34,9 @@ struct Event {
     double x, y;                 // centre of the ball
     Velocities<double> before;   // (u, v, W) arriving
     Velocities<double> after;    // (u, v, W) leaving
+    // Wall and floor impacts: whether the impact slid (Walton's law, SPEC.md 1b) and its
+    // tangential factor beta (alpha where it gripped).
+    Contact contact{};
 };
 
 // A point on a flight parabola; `segment` is the index of the event the flight starts from.

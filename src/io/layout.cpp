@@ -44,6 +44,10 @@ VariableText variable_text(std::string_view name)
         {"alpha_wall", {"tangential coefficient of restitution of the wall", "1"}},
         {"e_floor", {"normal coefficient of restitution of the floor", "1"}},
         {"alpha_floor", {"tangential coefficient of restitution of the floor", "1"}},
+        {"mu", {"Coulomb friction coefficient, wall and floor", "1"}},
+        {"mu_wall", {"Coulomb friction coefficient of the wall", "1"}},
+        {"mu_floor", {"Coulomb friction coefficient of the floor", "1"}},
+        {"inertia", {"moment of inertia of the ball over m a^2", "1"}},
     };
     for (const auto& row : table) {
         if (row.name == name) return row.text;

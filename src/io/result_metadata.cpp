@@ -103,12 +103,16 @@ std::vector<h5::Id> write_metadata(hid_t file, const Job& job, const Grid& grid,
     put(file, attr::axis_names, axis_names);
     // A swept coefficient has no single value: its attribute names the axis instead
     // ("axis:e"), and `swept` lists the coefficient axes.
-    const std::pair<const char*, double> coefficients[] = {{"e_wall", job.model.wall.e},
-                                                           {"alpha_wall", job.model.wall.alpha},
-                                                           {"e_floor", job.model.floor.e},
-                                                           {"alpha_floor", job.model.floor.alpha}};
-    for (std::size_t c = 0; c < 4; ++c) {
-        const auto [key, value] = coefficients[c];
+    // Every coefficient; SPEC.md 1b's (mu_wall, mu_floor, inertia) where not their defaults,
+    // so that a file of the Cross model of a solid ball is what it was before them (and no
+    // attribute is infinite: readers take a missing one as the default).
+    const std::vector<std::string> keys = model_coefficient_names();
+    const std::array<double, swept_coefficients> values = model_coefficients(job.model);
+    const std::array<double, swept_coefficients> defaults = model_coefficients(Model{});
+    for (std::size_t c = 0; c < swept_coefficients; ++c) {
+        const std::string& key = keys[c];
+        const double value = values[c];
+        if (is_friction_coefficient(key) && job.swept[c] < 0 && value == defaults[c]) continue;
         if (job.swept[c] < 0) {
             h5::write_attribute(file, key, value);
         } else {

@@ -8,7 +8,38 @@ std::vector<std::string> coordinate_names(Coordinates c)
     return {"x", "u", "v", "omega"};
 }
 
-std::vector<std::string> coefficient_names() { return {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor"}; }
+std::vector<std::string> coefficient_names()
+{
+    return {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "mu", "mu_wall", "mu_floor", "inertia"};
+}
+
+std::vector<std::string> model_coefficient_names()
+{
+    return {"e_wall", "alpha_wall", "e_floor", "alpha_floor", "mu_wall", "mu_floor", "inertia"};
+}
+
+bool coefficient_in_range(std::string_view name, double value)
+{
+    if (name.starts_with("alpha")) return alpha_in_range(value);
+    if (name.starts_with("mu")) return mu_in_range(value);
+    if (name == "inertia") return inertia_in_range(value);
+    return e_in_range(value);
+}
+
+const char* coefficient_range_text(std::string_view name)
+{
+    if (name.starts_with("alpha")) return alpha_range_text;
+    if (name.starts_with("mu")) return mu_range_text;
+    if (name == "inertia") return inertia_range_text;
+    return e_range_text;
+}
+
+bool is_friction_coefficient(std::string_view name) { return name.starts_with("mu") || name == "inertia"; }
+
+std::array<double, swept_coefficients> model_coefficients(const Model& m)
+{
+    return {m.wall.e, m.wall.alpha, m.floor.e, m.floor.alpha, m.wall.mu, m.floor.mu, m.inertia};
+}
 
 std::vector<const Coordinate*> Job::range_axes() const
 {
@@ -23,8 +54,10 @@ std::vector<const Coordinate*> Job::range_axes() const
 Model Job::model_at(std::span<const double> parameter_values) const
 {
     Model m = model;
-    double* const coefficient[4] = {&m.wall.e, &m.wall.alpha, &m.floor.e, &m.floor.alpha};
-    for (std::size_t k = 0; k < 4; ++k) {
+    // In the order of model_coefficient_names().
+    double* const coefficient[swept_coefficients] = {&m.wall.e,  &m.wall.alpha, &m.floor.e, &m.floor.alpha,
+                                                     &m.wall.mu, &m.floor.mu,   &m.inertia};
+    for (std::size_t k = 0; k < swept_coefficients; ++k) {
         if (swept[k] >= 0) *coefficient[k] = parameter_values[static_cast<std::size_t>(swept[k])];
     }
     return m;

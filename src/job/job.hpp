@@ -48,8 +48,22 @@ struct Coordinate {
 };
 
 // The model coefficients a job may sweep as range axes, in the order their axes come in
-// results (before the coordinates).
-std::vector<std::string> coefficient_names();  // {"e","alpha","e_wall","alpha_wall","e_floor","alpha_floor"}
+// results (before the coordinates): e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, and
+// SPEC.md 1b's mu, mu_wall, mu_floor, inertia.
+std::vector<std::string> coefficient_names();
+// The model's own coefficients, one value each (what `Job::swept` and a result's attributes
+// hold): e_wall, alpha_wall, e_floor, alpha_floor, mu_wall, mu_floor, inertia.
+std::vector<std::string> model_coefficient_names();
+inline constexpr std::size_t swept_coefficients = 7;
+// A coefficient's value in its physical range (model.hpp), by its name ("e", "e_wall",
+// "alpha", "mu_floor", "inertia", ...), and the range as text for messages.
+bool coefficient_in_range(std::string_view name, double value);
+const char* coefficient_range_text(std::string_view name);
+// SPEC.md 1b's coefficients (mu, mu_wall, mu_floor, inertia): results hold them only where
+// they are not their defaults, and files written before them have none.
+bool is_friction_coefficient(std::string_view name);
+// The values of model_coefficient_names() in `m`, in that order.
+std::array<double, swept_coefficients> model_coefficients(const Model& m);
 
 struct Job {
     Model model{};  // swept coefficients hold their range's min here (see model_at)
@@ -58,9 +72,9 @@ struct Job {
     std::vector<Coordinate> grid;         // every coordinate, in coordinate_names() order
     // Model coefficients given as ranges in [model], in coefficient_names() order.
     std::vector<Coordinate> parameters;
-    // For e_wall, alpha_wall, e_floor, alpha_floor: the index in `parameters` of the axis
-    // that sets it, or -1 when it is fixed (per-surface keys override e and alpha).
-    std::array<int, 4> swept{-1, -1, -1, -1};
+    // For each of model_coefficient_names(): the index in `parameters` of the axis that sets
+    // it, or -1 when it is fixed (per-surface keys override e, alpha and mu).
+    std::array<int, swept_coefficients> swept{-1, -1, -1, -1, -1, -1, -1};
     std::uint32_t max_bounces = 1000;
     std::string output;                   // [run] output, as written (may be empty: then the CLI must be given one)
     std::optional<std::uint64_t> tile_points;  // [run] tile_points: target points per tile

@@ -35,7 +35,8 @@ constexpr std::int64_t max_tile_points = std::int64_t{1} << 24;
 constexpr std::int64_t max_max_bounces = std::numeric_limits<std::uint32_t>::max();
 
 const std::vector<std::string> top_level_keys = {"model", "grid", "run"};
-const std::vector<std::string> model_keys = {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "g", "radius"};
+const std::vector<std::string> model_keys = {"e",  "alpha",   "e_wall",   "alpha_wall", "e_floor", "alpha_floor",
+                                             "mu", "mu_wall", "mu_floor", "inertia",    "g",       "radius"};
 const std::vector<std::string> range_keys = {"min", "max", "n"};
 const std::vector<std::string> run_keys = {"max_bounces", "output",      "tile_points", "refine",
                                            "compression", "alignment", "checkpoint_seconds", "writers"};
@@ -394,22 +395,26 @@ void parse_model(const toml::table* model, Coordinates kind, Job& job)
         return at_max ? r.max : r.min;
     };
     for (const bool at_max : {false, true}) {
-        const ModelInput in{value(0, at_max), value(1, at_max), value(2, at_max),
-                            value(3, at_max), value(4, at_max), value(5, at_max)};
+        const ModelInput in{value(0, at_max), value(1, at_max), value(2, at_max), value(3, at_max), value(4, at_max),
+                            value(5, at_max), value(6, at_max), value(7, at_max), value(8, at_max), value(9, at_max)};
         const Model m = resolve_model(in, [&](std::string_view key) {
             const auto k = static_cast<std::size_t>(std::find(names.begin(), names.end(), key) - names.begin());
             return spell(key) + (k < names.size() && axis[k] >= 0 ? (at_max ? ".max" : ".min") : "");
         });
         if (!at_max) job.model = m;
     }
-    // Which axis sets each coefficient: a per-surface key wins over the shared one.
-    const std::size_t shared[4] = {0, 1, 0, 1}, specific[4] = {2, 3, 4, 5};
-    for (std::size_t c = 0; c < 4; ++c) {
+    // Which axis sets each coefficient of the model (model_coefficient_names()): a per-surface
+    // key wins over the shared one; inertia is its own.
+    const std::size_t shared[swept_coefficients] = {0, 1, 0, 1, 6, 6, 9}, specific[swept_coefficients] = {2, 3, 4, 5, 7, 8, 9};
+    for (std::size_t c = 0; c < swept_coefficients; ++c) {
         job.swept[c] = model->contains(names[specific[c]]) ? axis[specific[c]] : axis[shared[c]];
     }
-    for (const std::size_t k : {0u, 1u}) {
-        if (axis[k] >= 0 && model->contains(names[k + 2]) && model->contains(names[k + 4])) {
-            fail("[model] " + names[k] + " is a range, but " + names[k + 2] + " and " + names[k + 4] +
+    // A shared key swept while both per-surface keys are set: nothing would follow it.
+    const std::size_t wall_key[3] = {2, 3, 7}, floor_key[3] = {4, 5, 8}, shared_key[3] = {0, 1, 6};
+    for (std::size_t k = 0; k < 3; ++k) {
+        const std::size_t key = shared_key[k];
+        if (axis[key] >= 0 && model->contains(names[wall_key[k]]) && model->contains(names[floor_key[k]])) {
+            fail("[model] " + names[key] + " is a range, but " + names[wall_key[k]] + " and " + names[floor_key[k]] +
                  " are set too: nothing would follow it");
         }
     }
@@ -565,6 +570,14 @@ std::string fingerprint(const Job& job)
     out += "alpha_wall = " + format_double(job.model.wall.alpha) + "\n";
     out += "e_floor = " + format_double(job.model.floor.e) + "\n";
     out += "alpha_floor = " + format_double(job.model.floor.alpha) + "\n";
+    // SPEC.md 1b, only where not the defaults: a job of the Cross model of a solid ball keeps
+    // the fingerprint it had before they existed (its partial files resume).
+    const Model defaults{};
+    if (job.model.wall.mu != defaults.wall.mu || job.swept[4] >= 0) out += "mu_wall = " + format_double(job.model.wall.mu) + "\n";
+    if (job.model.floor.mu != defaults.floor.mu || job.swept[5] >= 0) {
+        out += "mu_floor = " + format_double(job.model.floor.mu) + "\n";
+    }
+    if (job.model.inertia != defaults.inertia || job.swept[6] >= 0) out += "inertia = " + format_double(job.model.inertia) + "\n";
     if (job.coordinates == Coordinates::physical) {
         out += "g = " + format_double(job.frame.g) + "\n";
         out += "radius = " + format_double(job.frame.radius) + "\n";

@@ -1,12 +1,25 @@
 #include "result_json.hpp"
 
+#include <cmath>
+
 #include "core/trajectory.hpp"
 
 namespace superball {
 
+// SPEC.md 1b's coefficients where not their defaults, as model_text() and a result's
+// attributes have them (so the Cross model of a solid ball prints as before, and no mu is
+// infinite: JSON has no infinity).
 nlohmann::ordered_json model_json(const Model& m)
 {
-    return {{"e_wall", m.wall.e}, {"alpha_wall", m.wall.alpha}, {"e_floor", m.floor.e}, {"alpha_floor", m.floor.alpha}};
+    nlohmann::ordered_json out = {
+        {"e_wall", m.wall.e}, {"alpha_wall", m.wall.alpha}, {"e_floor", m.floor.e}, {"alpha_floor", m.floor.alpha}};
+    const Model defaults{};
+    if (m.wall.mu != defaults.wall.mu || m.floor.mu != defaults.floor.mu) {
+        out["mu_wall"] = std::isfinite(m.wall.mu) ? nlohmann::ordered_json(m.wall.mu) : nlohmann::ordered_json("inf");
+        out["mu_floor"] = std::isfinite(m.floor.mu) ? nlohmann::ordered_json(m.floor.mu) : nlohmann::ordered_json("inf");
+    }
+    if (m.inertia != defaults.inertia) out["inertia"] = m.inertia;
+    return out;
 }
 
 std::string count_json(const BounceCount& r, const CanonicalState<double>& start)
@@ -29,7 +42,8 @@ std::string trajectory_json(const Trajectory& tr, const Start& start, const Mode
                                   {"events_truncated", tr.truncated}};
     nlohmann::ordered_json& events = out["events"] = nlohmann::ordered_json::array();
     for (const Event& e : tr.events) {
-        events.push_back({{"event", name(e.kind)},
+        nlohmann::ordered_json& event = events.emplace_back();
+        event = {{"event", name(e.kind)},
                           {"wall_bounces", e.wall_bounces},
                           {"t", e.t},
                           {"x", e.x},
@@ -39,7 +53,12 @@ std::string trajectory_json(const Trajectory& tr, const Start& start, const Mode
                           {"omega_in", e.before.W / a},
                           {"u", e.after.u},
                           {"v", e.after.v},
-                          {"omega", e.after.W / a}});
+                          {"omega", e.after.W / a}};
+        // Impacts (SPEC.md 1b): whether each gripped or slid, and its tangential factor.
+        if (e.kind == EventKind::wall || e.kind == EventKind::floor) {
+            event["contact"] = e.contact.slid ? "slide" : "grip";
+            event["beta"] = e.contact.beta;
+        }
     }
     nlohmann::ordered_json& path = out["path"] = nlohmann::ordered_json::array();
     for (const PathPoint& p : tr.path) {

@@ -20,8 +20,9 @@ void add_dynamics(pybind11::module_& m);
 }  // namespace superball
 
 // The model's coefficients as the package passes them to _core: one dict (`model=`, made by
-// superball._model) of e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, each a float or
-// None (not given), rather than six arguments of every function.
+// superball._model) of e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall,
+// mu_floor, inertia, each a float or None (not given), rather than ten arguments of every
+// function.
 namespace pybind11::detail {
 template <>
 struct type_caster<superball::ModelInput> {
@@ -30,12 +31,8 @@ struct type_caster<superball::ModelInput> {
     {
         if (!isinstance<dict>(src)) return false;
         const auto given = reinterpret_borrow<dict>(src);
-        const std::pair<const char*, std::optional<double> superball::ModelInput::*> keys[] = {
-            {"e", &superball::ModelInput::e},           {"alpha", &superball::ModelInput::alpha},
-            {"e_wall", &superball::ModelInput::e_wall}, {"alpha_wall", &superball::ModelInput::alpha_wall},
-            {"e_floor", &superball::ModelInput::e_floor}, {"alpha_floor", &superball::ModelInput::alpha_floor}};
         std::size_t known = 0;
-        for (const auto& [key, member] : keys) {
+        for (const auto& [key, member] : superball::model_input_keys) {
             if (!given.contains(key)) continue;
             ++known;
             const object v = given[key];

@@ -283,6 +283,10 @@ py::tuple trajectory_table(const StartInput& in, const ModelInput& given, std::u
         {"u_in", &TrajectoryRow::u_in}, {"v_in", &TrajectoryRow::v_in}, {"omega_in", &TrajectoryRow::omega_in},
         {"u", &TrajectoryRow::u},       {"v", &TrajectoryRow::v},   {"omega", &TrajectoryRow::omega}};
     for (const auto& [key, member] : doubles) columns[key] = column(rows, member);
+    py::list contacts;
+    for (const TrajectoryRow& r : rows) contacts.append(py::str(std::string(r.contact)));
+    columns["contact"] = contacts;
+    columns["beta"] = column(rows, &TrajectoryRow::beta);
     py::dict result;
     result["wall_bounces"] = tr.result.wall_bounces;
     result["outcome"] = std::string(name(tr.result.outcome));

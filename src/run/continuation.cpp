@@ -340,6 +340,11 @@ void check_bounds(Parameter p, const std::optional<double>& lo, const std::optio
         if (!parameter_in_range(p, *value)) {
             throw InputError(*key + " = " + format_double(*value) + " is out of range: accepted " + range);
         }
+        // mu = inf is a model (the Cross model), not a point a branch can be followed to.
+        if (!std::isfinite(*value)) {
+            throw InputError(*key + " = " + format_double(*value) + " is not finite: a branch is followed between finite " +
+                             p_name);
+        }
     }
     if (!(*lo < *hi)) throw InputError(lo_key + " = " + format_double(*lo) + " is not below " + hi_key + " = " + format_double(*hi));
     if (p0 < *lo || p0 > *hi) {

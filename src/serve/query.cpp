@@ -124,7 +124,13 @@ std::optional<std::string> Query::choice(std::string_view key, const std::vector
     refuse(spelled + ": accepted " + either(choices));
 }
 
-std::vector<std::string> model_keys() { return {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "max_bounces"}; }
+std::vector<std::string> model_keys()
+{
+    std::vector<std::string> k;
+    for (const ModelKey& key : model_input_keys) k.emplace_back(key.name);
+    k.emplace_back("max_bounces");
+    return k;
+}
 
 std::vector<std::string> start_keys() { return {"xi", "U", "W", "x", "u", "v", "omega", "g", "radius"}; }
 

@@ -62,8 +62,9 @@ Range parse_range(Query& q, std::string_view axis, const std::string& name, bool
 
 ModelInput parse_model_input(Query& q)
 {
-    return {q.number("e"), q.number("alpha"), q.number("e_wall"), q.number("alpha_wall"), q.number("e_floor"),
-            q.number("alpha_floor")};
+    ModelInput in;
+    for (const ModelKey& key : model_input_keys) in.*key.member = q.number(key.name);
+    return in;
 }
 
 Model parse_model(Query& q, ModelInput& input)
@@ -153,11 +154,10 @@ std::string job_toml(const View& v, std::string_view output, std::string_view co
     t += "#          or: sbatch -n RANKS -t HH:MM:SS jobs/slurm/explore.sbatch THIS.toml\n";
     t += comment;
     t += "\n[model]\n";
-    const std::pair<const char*, const std::optional<double>*> model[] = {
-        {"e", &v.model_input.e},           {"alpha", &v.model_input.alpha},         {"e_wall", &v.model_input.e_wall},
-        {"alpha_wall", &v.model_input.alpha_wall}, {"e_floor", &v.model_input.e_floor}, {"alpha_floor", &v.model_input.alpha_floor}};
-    for (const auto& [key, value] : model) {
-        if (*value) t += std::string(key) + " = " + toml_float(**value) + "\n";
+    for (const ModelKey& key : model_input_keys) {
+        if (const std::optional<double>& value = v.model_input.*key.member) {
+            t += std::string(key.name) + " = " + toml_float(*value) + "\n";
+        }
     }
     t += "\n[grid]\ncoordinates = \"canonical\"\n";
     for (int k = 0; k < 3; ++k) {

@@ -5,7 +5,8 @@
 // Reported: ns per map iteration (items = iterations of G) and points/s of the scalar
 // kernel and of every variant of the vectorised kernel this processor runs
 // (core/kernels.hpp) on the issue-4 slice U = -1, xi in (0, 1), W in [-3, 3],
-// e = alpha = 0.9. The context line "superball" names the variants.
+// e = alpha = 0.9 (BM_count_slice_mu1: the same with Coulomb friction mu = 1, SPEC.md 1b). The
+// context line "superball" names the variants.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -23,6 +24,16 @@ using namespace superball;
 
 
 const ModelMatrices slice_model = ModelMatrices::of(Model::uniform(0.9, 0.9));
+
+// The same slice with Coulomb friction mu = 1 on both surfaces (SPEC.md 1b): the kernels'
+// Walton path, where every impact takes its friction limit (BM_count_slice_mu1).
+ModelMatrices frictional_slice_model()
+{
+    Model m = Model::uniform(0.9, 0.9);
+    m.wall.mu = m.floor.mu = 1.0;
+    return ModelMatrices::of(m);
+}
+const ModelMatrices slice_model_mu1 = frictional_slice_model();
 
 // n x n cell centres of the benchmark slice.
 std::vector<CanonicalState<double>> slice(std::size_t n)
@@ -68,13 +79,14 @@ BENCHMARK(BM_physical_map);
 
 // Counts every start once per iteration with `kernel`; items are points, and the counter
 // the time per iteration of G.
-void run_kernel(benchmark::State& state, const KernelVariant& kernel, const std::vector<CanonicalState<double>>& starts)
+void run_kernel(benchmark::State& state, const KernelVariant& kernel, const std::vector<CanonicalState<double>>& starts,
+                const ModelMatrices& model = slice_model)
 {
     std::vector<std::uint32_t> wb(starts.size());
     std::vector<std::uint8_t> oc(starts.size());
     const Starts points = Starts::of(starts);
     for (auto _ : state) {
-        kernel.count(points.view(), slice_model, 1000, wb, oc);
+        kernel.count(points.view(), model, 1000, wb, oc);
         benchmark::ClobberMemory();
     }
     std::uint64_t iterations = 0;
@@ -177,6 +189,14 @@ int main(int argc, char** argv)
         for (const std::size_t n : {512, 4096}) {
             benchmark::RegisterBenchmark(("BM_count_slice/" + std::string(k->name) + "/" + std::to_string(n)).c_str(),
                                          [k, n](benchmark::State& state) { run_kernel(state, *k, slice(n)); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+        }
+    }
+    for (const KernelVariant* k : kernels) {
+        for (const std::size_t n : {512, 4096}) {
+            benchmark::RegisterBenchmark(("BM_count_slice_mu1/" + std::string(k->name) + "/" + std::to_string(n)).c_str(),
+                                         [k, n](benchmark::State& state) { run_kernel(state, *k, slice(n), slice_model_mu1); })
                 ->Unit(benchmark::kMillisecond)
                 ->UseRealTime();
         }

@@ -31,7 +31,7 @@ PHYSICAL = ["--x", "0.02", "--u", "-2.0", "--v", "2.0", "--omega", "-200.0"]
 EXAMPLE_G = 9.81
 EXAMPLE_RADIUS = 0.025
 
-CSV_HEADER = "event,wall_bounces,t,x,y,u_in,v_in,omega_in,u,v,omega"
+CSV_HEADER = "event,wall_bounces,t,x,y,u_in,v_in,omega_in,u,v,omega,contact,beta"
 HELP_HINT = "Run with --help for usage."
 REL_TOL = 1e-12
 
@@ -221,8 +221,11 @@ def parse_csv(text):
     rows = list(csv.DictReader(io.StringIO(text)))
     for row in rows:
         for key in row:
-            if key != "event":
+            if key not in ("event", "contact"):
                 row[key] = float(row[key])
+        # SPEC.md 1b: every impact says whether it gripped or slid, nothing else does.
+        assert (row["contact"] in ("grip", "slide")) == (row["event"] in ("wall", "floor")), row
+        assert math.isnan(row["beta"]) == (row["contact"] == ""), row
     return header, rows
 
 

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <random>
@@ -261,6 +262,31 @@ public:
         return chance(0.5) ? Model{wall, wall} : Model{wall, surface()};
     }
 
+    // SPEC.md 1b: mu from 0.05 to 5 (log-uniform), now and then 0 or infinite; inertia in
+    // (0, 2/3], now and then 2/5 or 2/3 exactly.
+    double mu()
+    {
+        const double r = uniform(0.0, 1.0);
+        return r < 0.05 ? 0.0 : r < 0.1 ? std::numeric_limits<double>::infinity() : log_uniform(0.05, 5.0);
+    }
+    double inertia()
+    {
+        const double r = uniform(0.0, 1.0);
+        if (r < 0.1) return solid_ball_inertia;
+        if (r < 0.2) return thin_shell_inertia;
+        double k = 0.0;
+        while (!(k > 0.0)) k = uniform(0.0, thin_shell_inertia);
+        return k;
+    }
+    Model walton_model()
+    {
+        Model m = model();
+        m.wall.mu = mu();
+        m.floor.mu = chance(0.5) ? m.wall.mu : mu();
+        m.inertia = inertia();
+        return m;
+    }
+
     // A canonical launch with 0 < xi < xi_max, U from -0.02 to -20 (log-uniform) and
     // |W| <= 5.
     CanonicalState<double> launch(double xi_min = 0.0, double xi_max = 1.0)
@@ -279,8 +305,9 @@ private:
 
 inline std::string describe(const Model& m)
 {
-    return "{e_wall " + full(m.wall.e) + ", alpha_wall " + full(m.wall.alpha) + ", e_floor " + full(m.floor.e) +
-           ", alpha_floor " + full(m.floor.alpha) + "}";
+    return "{e_wall " + full(m.wall.e) + ", alpha_wall " + full(m.wall.alpha) + ", mu_wall " + full(m.wall.mu) +
+           ", e_floor " + full(m.floor.e) + ", alpha_floor " + full(m.floor.alpha) + ", mu_floor " + full(m.floor.mu) +
+           ", inertia " + full(m.inertia) + "}";
 }
 
 inline std::string describe(const CanonicalState<double>& c)

@@ -90,12 +90,20 @@ double pair_modulus(const std::array<std::complex<double>, 3>& ev)
 // the value part bit for bit the double instantiation's.
 TEST(Continuation, ParameterDerivativeMatchesCentralDifferences)
 {
+    // Also a model with friction and another ball (SPEC.md 1b): mu and inertia are
+    // parameters too (an infinite mu is not: continuation starts from a finite one).
+    Model frictional = Model::uniform(0.9, 0.9);
+    frictional.wall.mu = 2.0;
+    frictional.floor.mu = 3.0;
+    frictional.inertia = 0.5;
     for (const int k : {1, 2}) {
-        for (const Model& model : test::models(k)) {
+        std::vector<Model> models = test::models(k);
+        models.push_back(frictional);
+        for (const Model& model : models) {
             const ModelMatrices m = ModelMatrices::of(model);
             for (const CanonicalState<double>& s : test::admissible_states(m, k, 20, 5 + static_cast<std::uint64_t>(k))) {
                 for (const Parameter p : all_parameters) {
-                    if (!parameter_defined(model, p)) continue;
+                    if (!parameter_defined(model, p) || !std::isfinite(parameter_value(model, p))) continue;
                     const ParameterJacobian j = parameter_jacobian(s, model, p, k);
                     ASSERT_TRUE(j.finite);
                     const IterateJacobian ref = iterate_jacobian(s, m, k);

@@ -44,13 +44,13 @@ def setUpModule():
         raise RuntimeError("set SUPERBALL to the built superball binary (got %r)" % SUPERBALL)
 
 
-def read_rows(path):
+def read_rows(path, expected=HEADER):
     """(line number, dict) of every data row; '#' lines are comments."""
     with open(path, newline="") as f:
         numbered = [(i + 1, line) for i, line in enumerate(f) if line.strip() and not line.startswith("#")]
     header = next(csv.reader([numbered[0][1]]))
-    if header != HEADER:
-        raise AssertionError("%s: header %r, expected %r" % (path, header, HEADER))
+    if header != expected:
+        raise AssertionError("%s: header %r, expected %r" % (path, header, expected))
     return [(n, dict(zip(header, fields))) for (n, _), fields in
             zip(numbered[1:], csv.reader(line for _, line in numbered[1:]))]
 
@@ -175,6 +175,72 @@ class MpReference(unittest.TestCase):
         print("%d rows of mp_counts.csv checked through `superball count --json`" % len(rows), file=sys.stderr)
 
 
+FRICTION_HEADER = ["e_wall", "alpha_wall", "mu_wall", "e_floor", "alpha_floor", "mu_floor", "inertia", "max_bounces", "xi",
+                   "U", "W", "wall_bounces", "outcome", "slides"]
+FRICTION_COUNTS = os.path.join(REFERENCE_DIR, "mp_friction_counts.csv")
+FRICTION_MODEL = ("e_wall", "alpha_wall", "mu_wall", "e_floor", "alpha_floor", "mu_floor", "inertia")
+
+
+class FrictionReference(unittest.TestCase):
+    """SPEC section 1b (Walton's friction law, the moment of inertia) against
+    tests/reference/mp_friction_counts.csv (mp_reference.py --friction): every row through
+    the Python module, a sample and the invalid rows through `superball count` with --mu-wall,
+    --mu-floor and --inertia. (Every kernel variant is checked on every row by test_core's
+    FrictionReference.)"""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.rows = read_rows(FRICTION_COUNTS, FRICTION_HEADER)
+
+    def test_file_covers_the_issue(self):
+        rows = [r for _, r in self.rows]
+        self.assertGreaterEqual(len(rows), 500)
+        self.assertGreater(sum(int(r["slides"]) > 0 for r in rows), len(rows) // 3)
+        self.assertGreater(sum(r["outcome"] == "capped" for r in rows), 100)
+        self.assertGreater(sum(int(r["wall_bounces"]) >= 100 and int(r["slides"]) > 0 for r in rows), 50)
+        self.assertGreaterEqual(len({r["inertia"] for r in rows}), 4)
+        self.assertGreaterEqual(len({r["mu_wall"] for r in rows}), 5)
+
+    def test_module_and_command_line_match_every_row(self):
+        module, why_not = load_module()
+        mismatches = []
+        sample = self.rows if module is None else [
+            nr for i, nr in enumerate(self.rows) if i % CLI_SAMPLE_EVERY == 0 or nr[1]["outcome"] == "invalid"]
+        if module is not None:
+            import numpy as np
+
+            groups = {}
+            for number, row in self.rows:
+                groups.setdefault(tuple(row[k] for k in FRICTION_MODEL + ("max_bounces",)), []).append((number, row))
+            for key, members in sorted(groups.items()):
+                model = dict(zip(FRICTION_MODEL, map(float, key[:-1])))
+                xi, U, W = (np.array([float(r[k]) for _, r in members]) for k in ("xi", "U", "W"))
+                c = module.count(xi, U, W, max_bounces=int(key[-1]), threads=1, **model)
+                for i, (number, row) in enumerate(members):
+                    got = (int(c.wall_bounces[i]), OUTCOMES[int(c.outcome[i])])
+                    if got != (int(row["wall_bounces"]), row["outcome"]):
+                        mismatches.append("line %d: the module gives %s, the reference %s %s" %
+                                          (number, got, row["wall_bounces"], row["outcome"]))
+        else:
+            print("\nthe Python module is not used (%s): every row through the command line" % why_not, file=sys.stderr)
+        for number, row in sample:
+            flags = ["--%s=%s" % (key.replace("_", "-"), row[key]) for key in FRICTION_MODEL + ("xi", "U", "W", "max_bounces")]
+            r = subprocess.run([SUPERBALL, "count", "--json"] + flags, capture_output=True, text=True, timeout=60)
+            if row["outcome"] == "invalid":
+                if r.returncode != 2:
+                    mismatches.append("line %d: superball count does not refuse it (status %d)" % (number, r.returncode))
+                continue
+            if r.returncode != 0:
+                mismatches.append("line %d: superball count exited %d: %s" % (number, r.returncode, r.stderr.strip()))
+                continue
+            out = json.loads(r.stdout)
+            if (out["wall_bounces"], out["outcome"]) != (int(row["wall_bounces"]), row["outcome"]):
+                mismatches.append("line %d: superball count gives %s %s" % (number, out["wall_bounces"], out["outcome"]))
+        self.assertEqual(mismatches, [], "%d rows of mp_friction_counts.csv disagree" % len(mismatches))
+        print("%d rows through the module, %d through `superball count --json`" %
+              (0 if module is None else len(self.rows), len(sample)), file=sys.stderr)
+
+
 class IndependentImplementations(unittest.TestCase):
     """mp_reference.py against the other independent reference, and against its own file."""
 
@@ -203,6 +269,20 @@ class IndependentImplementations(unittest.TestCase):
             model = self.mp.Model(row["e_wall"], row["alpha_wall"], row["e_floor"], row["alpha_floor"])
             got = self.mp.count(float(row["xi"]), float(row["U"]), float(row["W"]), model, int(row["max_bounces"]))
             self.assertEqual(got, (int(row["wall_bounces"]), row["outcome"]), describe(number, row))
+
+    def test_reproduces_its_own_friction_rows(self):
+        # The first row of each outcome, the longest motion and the one that slid most.
+        rows = [row for _, row in read_rows(FRICTION_COUNTS, FRICTION_HEADER)]
+        picks = {}
+        for row in rows:
+            picks.setdefault(row["outcome"], row)
+        picks["longest"] = max(rows, key=lambda r: int(r["wall_bounces"]))
+        picks["slid most"] = max(rows, key=lambda r: int(r["slides"]))
+        for what, row in picks.items():
+            model = self.mp.Model(row["e_wall"], row["alpha_wall"], row["e_floor"], row["alpha_floor"], row["mu_wall"],
+                                  row["mu_floor"], row["inertia"])
+            got = self.mp.count(float(row["xi"]), float(row["U"]), float(row["W"]), model, int(row["max_bounces"]))
+            self.assertEqual(got, (int(row["wall_bounces"]), row["outcome"]), "%s: %s" % (what, row))
 
     def test_documented_counts(self):
         # The `superball count` examples of README.md and docs/ with the answer printed

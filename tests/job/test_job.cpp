@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -574,7 +575,7 @@ TEST(Sweep, CoefficientRangeIsAnAxisBeforeTheCoordinates)
     EXPECT_EQ(axes[1]->name, "xi");
     EXPECT_EQ(job.points(), 32u);
     // alpha sets both surfaces' alpha; e_wall comes from e, e_floor is fixed.
-    EXPECT_EQ(job.swept, (std::array<int, 4>{-1, 0, -1, 0}));
+    EXPECT_EQ(job.swept, (std::array<int, swept_coefficients>{-1, 0, -1, 0, -1, -1, -1}));
     const double value[] = {0.7};
     const Model m = job.model_at(value);
     EXPECT_EQ(m.wall.alpha, 0.7);
@@ -587,7 +588,7 @@ TEST(Sweep, PerSurfaceRangeOverridesSharedValue)
 {
     const Job job = parse_job(
         sweep_job("e = 0.9\nalpha = 0.9\ne_wall = { min = 0.2, max = 0.4, n = 3 }\n", one_coordinate_range), source);
-    EXPECT_EQ(job.swept, (std::array<int, 4>{0, -1, -1, -1}));
+    EXPECT_EQ(job.swept, (std::array<int, swept_coefficients>{0, -1, -1, -1, -1, -1, -1}));
     const double value[] = {0.3};
     EXPECT_EQ(job.model_at(value).wall.e, 0.3);
     EXPECT_EQ(job.model_at(value).floor.e, 0.9);
@@ -607,6 +608,70 @@ TEST(Sweep, FingerprintIncludesTheSweep)
     const std::string a = sweep_job("e = 0.9\nalpha = { min = 0.5, max = 1, n = 4 }\n", one_coordinate_range);
     const std::string b = sweep_job("e = 0.9\nalpha = { min = 0.5, max = 1, n = 5 }\n", one_coordinate_range);
     EXPECT_NE(fingerprint(parse_job(a, source)), fingerprint(parse_job(b, source)));
+}
+
+// SPEC.md 1b: mu (both surfaces, per-surface keys override) and inertia, each a value or a
+// swept axis like e and alpha; absent, the Cross model of a solid ball.
+TEST(Friction, DefaultsAreTheCrossModelOfASolidBall)
+{
+    const Job job = parse_job(sweep_job("e = 0.9\nalpha = 0.9\n", one_coordinate_range), source);
+    EXPECT_EQ(job.model.wall.mu, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(job.model.floor.mu, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(job.model.inertia, 0.4);
+    // The fingerprint of such a job is the one it had before mu and inertia existed.
+    EXPECT_EQ(fingerprint(job).find("mu"), std::string::npos);
+    EXPECT_EQ(fingerprint(job).find("inertia"), std::string::npos);
+}
+
+TEST(Friction, ValuesAndPerSurfaceOverrides)
+{
+    const Job job =
+        parse_job(sweep_job("e = 0.9\nalpha = 0.9\nmu = 1.5\nmu_floor = 0.3\ninertia = 0.6\n", one_coordinate_range), source);
+    EXPECT_EQ(job.model.wall.mu, 1.5);
+    EXPECT_EQ(job.model.floor.mu, 0.3);
+    EXPECT_EQ(job.model.inertia, 0.6);
+    EXPECT_NE(fingerprint(job).find("mu_wall = 1.5\nmu_floor = 0.3\ninertia = 0.6\n"), std::string::npos) << fingerprint(job);
+    const Job infinite = parse_job(sweep_job("e = 0.9\nalpha = 0.9\nmu = inf\n", one_coordinate_range), source);
+    EXPECT_EQ(infinite.model.wall.mu, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(fingerprint(infinite), fingerprint(parse_job(sweep_job("e = 0.9\nalpha = 0.9\n", one_coordinate_range), source)));
+}
+
+TEST(Friction, MuAndInertiaSweep)
+{
+    const Job job = parse_job(sweep_job("e = 0.9\nalpha = 0.9\nmu = { min = 0.5, max = 3, n = 6 }\n"
+                                        "inertia = { min = 0.3, max = 0.6, n = 4 }\n",
+                                        one_coordinate_range),
+                              source);
+    ASSERT_EQ(job.parameters.size(), 2u);
+    EXPECT_EQ(job.parameters[0].name, "mu");
+    EXPECT_EQ(job.parameters[1].name, "inertia");
+    EXPECT_EQ(job.swept, (std::array<int, swept_coefficients>{-1, -1, -1, -1, 0, 0, 1}));
+    const double values[] = {2.0, 0.5};
+    const Model m = job.model_at(values);
+    EXPECT_EQ(m.wall.mu, 2.0);
+    EXPECT_EQ(m.floor.mu, 2.0);
+    EXPECT_EQ(m.inertia, 0.5);
+    EXPECT_EQ(job.points(), 6u * 4u * 8u);
+}
+
+TEST(Friction, BadValuesNameKeyValueAndRange)
+{
+    const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+        {"mu = -0.1\n", {"[model] mu = -0.1 is out of range", "0 <= mu"}},
+        {"mu = nan\n", {"[model] mu = nan is out of range"}},
+        {"mu_wall = -1\n", {"[model] mu_wall = -1 is out of range"}},
+        {"inertia = 0\n", {"[model] inertia = 0 is out of range", "0 < inertia <= 2/3"}},
+        {"inertia = 0.7\n", {"[model] inertia = 0.7 is out of range"}},
+        {"inertia = \"solid\"\n", {"[model] inertia = \"solid\"", "a string"}},
+        {"mu = { min = -1, max = 1, n = 4 }\n", {"[model] mu.min = -1", "0 <= mu"}},
+        {"mu = { min = 0.5, max = 1, n = 4 }\nmu_wall = 1\nmu_floor = 1\n", {"[model] mu is a range", "nothing would follow it"}},
+        {"inertie = 0.5\n", {"unknown key [model] inertie (did you mean inertia?)"}},
+    };
+    for (const auto& [extra, needles] : cases) {
+        const std::string message = error_of(sweep_job("e = 0.9\nalpha = 0.9\n" + extra, one_coordinate_range));
+        ASSERT_FALSE(message.empty()) << extra;
+        for (const std::string& needle : needles) EXPECT_NE(message.find(needle), std::string::npos) << message;
+    }
 }
 
 TEST(Sweep, Errors)

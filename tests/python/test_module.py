@@ -230,12 +230,34 @@ def test_trajectory_has_the_cli_csv(superball):
     assert list(t) == list(rows[0])
     assert len(t["t"]) == len(rows)
     for column in t:
-        if column == "event":
+        if column in ("event", "contact"):
             assert list(t[column]) == [r[column] for r in rows]
         else:
             np.testing.assert_array_equal(t[column], [float(r[column]) for r in rows])  # the same doubles
     canonical = superball.trajectory(0.05, -1, -2, **MODEL)
     assert canonical.units.startswith("dimensionless") and canonical.wall_bounces == 8
+
+
+def test_friction_and_inertia(superball):
+    """SPEC section 1b through the module: mu = inf and inertia = 0.4 are the defaults, bit for
+    bit; a row of tests/reference/mp_friction_counts.csv; each impact of a trajectory says
+    whether it slid, with its tangential factor beta in [-1, alpha]."""
+    xi, U, W = np.linspace(0.01, 0.99, 50), -1.0, np.linspace(-3, 3, 40)[:, None]
+    plain = superball.count(xi, U, W, **MODEL)
+    defaults = superball.count(xi, U, W, **MODEL, mu=float("inf"), inertia=0.4)
+    np.testing.assert_array_equal(plain.wall_bounces, defaults.wall_bounces)
+    np.testing.assert_array_equal(plain.outcome, defaults.outcome)
+    assert (superball.count(xi, U, W, **MODEL, mu=1.0).wall_bounces != plain.wall_bounces).any()
+    row = superball.count(0.00021810927870418665, -2.1256976997164694, -4.553173635519192, e=0.998, alpha=0.998, mu=1.5,
+                          inertia=0.4)
+    assert int(row.wall_bounces) == 839 and row.outcome == superball.Outcome.missed
+    t = superball.trajectory(0.05, -1, -2, **MODEL, mu=0.3, inertia=2 / 3)
+    impacts = [i for i, e in enumerate(t["event"]) if e in ("wall", "floor")]
+    assert {t["contact"][i] for i in impacts} == {"grip", "slide"}
+    for i in impacts:
+        assert -1 <= t["beta"][i] <= 0.9 + 1e-12
+        assert (t["beta"][i] == 0.9) == (t["contact"][i] == "grip")
+    assert np.isnan(t["beta"][0]) and t["contact"][0] == ""
 
 
 def test_fixed_points_and_continuation_print_what_the_cli_prints(superball):

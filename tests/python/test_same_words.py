@@ -31,6 +31,11 @@ CASES = [
     ("max_bounces past 2^32", dict(M, **CANONICAL, max_bounces=2**32)),
     ("model before start", dict(e=2)),
     ("start before max_bounces", dict(M, xi=0.1, max_bounces=0)),
+    # SPEC.md 1b
+    ("mu negative", dict(CANONICAL, **M, mu=-0.5)),
+    ("mu_floor NaN", dict(CANONICAL, **M, mu_floor=float("nan"))),
+    ("inertia 0", dict(CANONICAL, **M, inertia=0)),
+    ("inertia past a thin shell", dict(CANONICAL, **M, inertia=0.7)),
 ]
 
 

@@ -7,6 +7,11 @@ tests/reference/mp_counts.csv:
 
     /usr/bin/python3 tests/reference/mp_reference.py --out tests/reference/mp_counts.csv
 
+and (SPEC section 1b: Coulomb friction per surface, the ball's moment of inertia) of
+tests/reference/mp_friction_counts.csv:
+
+    nice -n 19 /usr/bin/python3 tests/reference/mp_reference.py --friction --out tests/reference/mp_friction_counts.csv
+
 What is computed (SPEC sections 1 to 3). A canonical launch (xi, U, W) is represented by
 the physical state with v = 1 and g = 1: x = 2 xi |U| (from xi = g x / (2 |u| v)),
 u = U, v = 1, W = W. Each excursion is the physical map F of SPEC section 1 applied as
@@ -50,6 +55,41 @@ the answer depends on the map being exactly SPEC's (energy-conserving, time-reve
 which no binary64 kernel's is. 12 such rows disagreed with the C++ kernel before the map
 perturbations were added to the test.
 
+Section 1b: friction and inertia (`--friction`). A Model also has a friction coefficient per
+surface, mu_wall and mu_floor (math.inf allowed: no Coulomb limit), and the ball's moment of
+inertia kappa (job key `inertia`, 0 < kappa <= 2/3). The Cross model of section 1 (mu = inf on
+both surfaces and kappa = 0.4, the defaults) keeps the coefficients above, so mp_counts.csv is
+reproduced as it was; any other model is iterated with SPEC 1b's impacts (class Surface), in
+mpmath, the flights as above:
+
+    wall:  s = v_w - W, v_n = -u;    floor: s = u+ + W+, v_n = -v_f;    psi = |s| / v_n
+    beta = min(alpha, -1 + mu (1 + e)(1 + 1/kappa) / psi)      (beta = alpha when s = 0, or mu = inf)
+    u+ = -e_w u,  v+ = ((1 - kappa beta) v_w + kappa (1 + beta) W) / (1 + kappa),
+                  W+ = ((1 + beta) v_w + (kappa - beta) W) / (1 + kappa)
+    u' = ((1 - kappa beta) u+ - kappa (1 + beta) W+) / (1 + kappa),
+    W' = ((kappa - beta) W+ - (1 + beta) u+) / (1 + kappa),  v' = -e_f v_f
+
+An impact slides when beta < alpha (its tangential impulse is then mu times the normal one;
+mu = 0: beta = -1), and grips otherwise. tests/reference/mp_friction_counts.csv has the columns
+
+    e_wall,alpha_wall,mu_wall,e_floor,alpha_floor,mu_floor,inertia,max_bounces,xi,U,W,wall_bounces,outcome,slides
+
+(floats as shortest round-trip decimals, infinity as `inf`; `slides`, for information: how many
+impacts of the orbit, wall and floor together, slid), for the models FRICTION_MODELS: mu from 0
+to 3 and inf, the same on both surfaces or not, kappa 0.25, 0.4, 0.5 and 2/3, e/alpha from
+0.8/0.6 to 1/1. Its rows pass the tests above with the map of section 1b: the coefficients
+rounded to binary64 or moved by a relative 1e-15 are e, alpha, kappa, 1/(1 + kappa),
+mu (1 + e)(1 + 1/kappa) and the four impact factors (a sliding impact's afresh at each impact);
+and, in addition, no impact of the orbit (dps 40) has psi within a relative 1e-9 (SWITCHING) of
+its grip/slide threshold psi* = mu (1 + e)(1 + 1/kappa)/(1 + alpha), where the map switches
+between its two smooth pieces, so the rows stay away from the switching surfaces.
+
+Other checks: `--self-test` (the invariants of SPEC 1b's impacts on random impacts: angular
+momentum about the contact point, s -> -beta s, kinetic energy, the Coulomb impulse ratio of a
+sliding impact, section 1's coefficients for mu = inf and kappa = 0.4), `--check-cross`
+(mp_counts.csv recomputed with SPEC 1b's impacts, mu = inf, kappa = 0.4: every row agrees),
+`--check-friction` (mp_friction_counts.csv recomputed), `--count-friction` (one launch).
+
 The generator is deterministic (a fixed seed); `--check-canonical` recomputes the rows of
 tests/reference/canonical_counts.csv (computed by another, independent, implementation).
 """
@@ -72,6 +112,7 @@ DPS_HIGH = 80
 PERTURBATION = 1e-12        # relative, of the launch
 COEFFICIENT_JITTER = 1e-15  # relative, of each impact coefficient (binary64 rounding: 1.1e-16)
 STEP_NOISE = 1e-14          # relative, of the state after each excursion (binary64: a few 1e-16)
+SWITCHING = 1e-9            # relative, the least distance of psi to a grip/slide threshold (section 1b)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -80,30 +121,61 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 class Model:
-    """Coefficients of restitution of both surfaces (binary64, as the kernel sees them)."""
+    """Coefficients of restitution of both surfaces, and (SPEC section 1b) the friction
+    coefficient of each surface and the ball's moment of inertia kappa (binary64, as the
+    kernel sees them). The defaults, mu = inf on both surfaces and kappa = 0.4, are the
+    Cross model of SPEC section 1 (`cross()`), which count_in iterates with section 1's
+    coefficients; any other model goes through the impacts of section 1b."""
 
-    def __init__(self, e_wall, alpha_wall, e_floor, alpha_floor):
+    def __init__(self, e_wall, alpha_wall, e_floor, alpha_floor, mu_wall=math.inf, mu_floor=math.inf,
+                 inertia=0.4):
         self.e_wall, self.alpha_wall = float(e_wall), float(alpha_wall)
         self.e_floor, self.alpha_floor = float(e_floor), float(alpha_floor)
+        self.mu_wall, self.mu_floor = float(mu_wall), float(mu_floor)
+        self.inertia = float(inertia)
         for e in (self.e_wall, self.e_floor):
             if not 0.0 < e <= 1.0:
                 raise ValueError("e out of range: %r" % e)
         for a in (self.alpha_wall, self.alpha_floor):
             if not -1.0 <= a <= 1.0:
                 raise ValueError("alpha out of range: %r" % a)
+        for mu in (self.mu_wall, self.mu_floor):
+            if not mu >= 0.0:
+                raise ValueError("mu out of range: %r" % mu)
+        if not 0.0 < self.inertia <= 2.0 / 3.0:
+            raise ValueError("inertia out of range: %r" % self.inertia)
 
     @classmethod
     def uniform(cls, e, alpha):
         return cls(e, alpha, e, alpha)
 
+    @classmethod
+    def friction(cls, e_wall, alpha_wall, mu_wall, e_floor, alpha_floor, mu_floor, inertia):
+        """The argument order of the friction CSV's columns."""
+        return cls(e_wall, alpha_wall, e_floor, alpha_floor, mu_wall, mu_floor, inertia)
+
+    @classmethod
+    def friction_uniform(cls, e, alpha, mu, inertia):
+        return cls(e, alpha, e, alpha, mu, mu, inertia)
+
+    def cross(self):
+        """The Cross model of SPEC section 1: no Coulomb limit, a solid ball."""
+        return math.isinf(self.mu_wall) and math.isinf(self.mu_floor) and self.inertia == 0.4
+
     def fields(self):
         return [self.e_wall, self.alpha_wall, self.e_floor, self.alpha_floor]
 
+    def friction_fields(self):
+        return [self.e_wall, self.alpha_wall, self.mu_wall, self.e_floor, self.alpha_floor, self.mu_floor,
+                self.inertia]
+
     def key(self):
-        return tuple(self.fields())
+        return tuple(self.fields()) if self.cross() else tuple(self.friction_fields())
 
     def __repr__(self):
-        return "Model(%r, %r, %r, %r)" % tuple(self.fields())
+        if self.cross():
+            return "Model(%r, %r, %r, %r)" % tuple(self.fields())
+        return "Model.friction(%r, %r, %r, %r, %r, %r, %r)" % tuple(self.friction_fields())
 
 
 class Arithmetic:
@@ -162,27 +234,117 @@ class Trace:
     """What a count saw besides its answer: the smallest |1 - xi_k| over every wall
     approach (how near the ball came to grazing the wall, or to reaching it on the last,
     missed approach), and the smallest |U| after a floor bounce (how near it came to
-    leaving, or to staying)."""
+    leaving, or to staying). Section 1b models also record how many impacts slid (beta <
+    alpha) and the smallest relative distance |psi - psi*| / psi* of an impact to the
+    grip/slide threshold psi* = mu (1 + e)(1 + 1/kappa)/(1 + alpha) (inf: none came near,
+    or no surface has one)."""
 
     def __init__(self):
         self.grazing = math.inf
         self.turning = math.inf
+        self.slides = 0
+        self.switching = math.inf
 
 
-def count_in(xi, U, W, model, max_bounces, A, trace=None, jitter=None):
+class CrossSurface:
+    """One surface of SPEC section 1 (the Cross model of a solid ball) in the arithmetic A,
+    with section 1's coefficients (1/7)(5 - 2 alpha) ... exactly as written there; with a
+    Jitter they are rounded to binary64 or moved (once). The same methods as Surface."""
+
+    def __init__(self, e, alpha, A, jitter=None):
+        coefficients = _surface(e, alpha, A)
+        if jitter is not None:
+            coefficients = jitter.surface(coefficients)
+        self.e, self.c_ss, self.c_sW, self.c_Ws, self.c_WW = coefficients
+
+    def wall(self, u, v_w, W, trace):
+        """Wall impact (eqs. 2, 6, 7): (u+, v+, W+)."""
+        return -self.e * u, self.c_sW * W + self.c_ss * v_w, self.c_Ws * v_w + self.c_WW * W
+
+    def floor(self, u, v_f, W, trace):
+        """Floor impact: (u', v', W')."""
+        return self.c_ss * u - self.c_sW * W, -self.e * v_f, self.c_WW * W - self.c_Ws * u
+
+
+class Surface:
+    """One surface of SPEC section 1b in the arithmetic A: restitution e, tangential
+    restitution alpha of an impact that grips, friction coefficient mu (inf: always grips),
+    and the ball's kappa. Holds kappa, d = 1/(1 + kappa), the Coulomb constant
+    c = mu (1 + e)(1 + 1/kappa) of the law beta = min(alpha, -1 + c/psi) (None for mu = inf)
+    and the impact factors of a gripping impact; with a Jitter these are rounded to binary64
+    or moved (once), and so are the factors of every sliding impact (each time)."""
+
+    def __init__(self, e, alpha, mu, kappa, A, jitter=None):
+        e, alpha, kappa = A.num(e), A.num(alpha), A.num(kappa)
+        one = A.num(1)
+        d = one / (1 + kappa)
+        c = None if math.isinf(mu) else A.num(mu) * (1 + e) * (1 + one / kappa)
+        self.jitter = jitter
+        if jitter is not None:
+            e, alpha, kappa, d = jitter.surface((e, alpha, kappa, d))
+            if c is not None:
+                c = jitter.surface((c,))[0]
+        self.e, self.alpha, self.kappa, self.d, self.c = e, alpha, kappa, d, c
+        self.grip = self.factors(alpha)
+        if jitter is not None:
+            self.grip = jitter.surface(self.grip)
+
+    def factors(self, beta):
+        """((1 - kappa beta), kappa (1 + beta), (1 + beta), (kappa - beta)), each / (1 + kappa):
+        SPEC 1b's impact, for the tangential factor beta."""
+        k, d = self.kappa, self.d
+        return (1 - k * beta) * d, k * (1 + beta) * d, (1 + beta) * d, (k - beta) * d
+
+    def law(self, s, v_n, trace):
+        """The factors of an impact with incoming contact velocity s and normal approach
+        speed v_n > 0: Walton's beta = min(alpha, -1 + mu (1 + e)(1 + 1/kappa)/psi),
+        psi = |s|/v_n (beta = alpha when s = 0 or mu = inf)."""
+        if self.c is None or s == 0:
+            return self.grip
+        psi = abs(s) / v_n
+        beta = -1 + self.c / psi
+        if trace is not None and self.c > 0 and self.alpha > -1:
+            # |psi - psi*| / psi*, psi* = c / (1 + alpha)
+            trace.switching = min(trace.switching, abs(float(psi * (1 + self.alpha) / self.c - 1)))
+        if not beta < self.alpha:
+            return self.grip
+        if trace is not None:
+            trace.slides += 1
+        f = self.factors(beta)
+        return f if self.jitter is None else self.jitter.surface(f)
+
+    def wall(self, u, v_w, W, trace):
+        """Wall impact (contact velocity s = v - W; kappa W + v conserved): (u+, v+, W+)."""
+        f_vv, f_vW, f_Wv, f_WW = self.law(v_w - W, -u, trace)
+        v_p = f_vv * v_w + f_vW * W  # ((1 - kappa beta) v_w + kappa (1 + beta) W) / (1 + kappa)
+        W_p = f_Wv * v_w + f_WW * W  # ((1 + beta) v_w + (kappa - beta) W) / (1 + kappa)
+        return -self.e * u, v_p, W_p
+
+    def floor(self, u, v_f, W, trace):
+        """Floor impact (contact velocity s = u + W; kappa W - u conserved): (u', v', W')."""
+        f_uu, f_uW, f_Wu, f_WW = self.law(u + W, -v_f, trace)
+        u_n = f_uu * u - f_uW * W  # ((1 - kappa beta) u - kappa (1 + beta) W) / (1 + kappa)
+        W_n = f_WW * W - f_Wu * u  # ((kappa - beta) W - (1 + beta) u) / (1 + kappa)
+        return u_n, -self.e * v_f, W_n
+
+
+def count_in(xi, U, W, model, max_bounces, A, trace=None, jitter=None, general=False):
     """(N, outcome name) of the canonical launch (xi, U, W), iterating SPEC's physical map
     in the arithmetic A. xi, U, W: numbers that convert exactly (floats or mpf). jitter
-    (mpmath only): perturbations of the map (class Jitter), for the robustness test."""
+    (mpmath only): perturbations of the map (class Jitter), for the robustness test.
+    The Cross model (model.cross()) with section 1's coefficients (CrossSurface) unless
+    `general`; any other model, or `general`, with the impacts of section 1b (Surface)."""
     for c in (xi, U, W):
         if not math.isfinite(float(c)):
             return 0, "invalid"
     if not (xi > 0 and U < 0):
         return 0, "invalid"
-    ew, w_ss, w_sW, w_Ws, w_WW = _surface(model.e_wall, model.alpha_wall, A)
-    ef, f_ss, f_sW, f_Ws, f_WW = _surface(model.e_floor, model.alpha_floor, A)
-    if jitter is not None:
-        ew, w_ss, w_sW, w_Ws, w_WW = jitter.surface((ew, w_ss, w_sW, w_Ws, w_WW))
-        ef, f_ss, f_sW, f_Ws, f_WW = jitter.surface((ef, f_ss, f_sW, f_Ws, f_WW))
+    if general or not model.cross():
+        wall = Surface(model.e_wall, model.alpha_wall, model.mu_wall, model.inertia, A, jitter)
+        floor = Surface(model.e_floor, model.alpha_floor, model.mu_floor, model.inertia, A, jitter)
+    else:
+        wall = CrossSurface(model.e_wall, model.alpha_wall, A, jitter)
+        floor = CrossSurface(model.e_floor, model.alpha_floor, A, jitter)
     g = A.num(1)
     # The representative with v = 1, g = 1.
     xi, u, W = A.num(xi), A.num(U), A.num(W)
@@ -201,19 +363,13 @@ def count_in(xi, U, W, model, max_bounces, A, trace=None, jitter=None):
         if n >= max_bounces:
             return n, "capped"
         v_w = v + g * r
-        # Wall impact (eqs. 2, 6, 7).
-        u_p = -ew * u
-        v_p = w_sW * W + w_ss * v_w
-        W_p = w_Ws * v_w + w_WW * W
+        u_p, v_p, W_p = wall.wall(u, v_w, W, trace)
         n += 1
         # Flight back to the floor.
         v_f = -A.sqrt(v_p * v_p + 2 * g * y)
         T = (v_p - v_f) / g
         x = u_p * T
-        # Floor impact.
-        u = f_ss * u_p - f_sW * W_p
-        W = f_WW * W_p - f_Ws * u_p
-        v = -ef * v_f
+        u, v, W = floor.floor(u_p, v_f, W_p, trace)
         if trace is not None:
             trace.turning = min(trace.turning, abs(float(u / v)))
         if u >= 0:
@@ -227,10 +383,10 @@ def count_in(xi, U, W, model, max_bounces, A, trace=None, jitter=None):
             x, u, W = jitter.state(x, u, W)
 
 
-def count(xi, U, W, model, max_bounces, dps=DPS_LOW, trace=None, jitter=None):
+def count(xi, U, W, model, max_bounces, dps=DPS_LOW, trace=None, jitter=None, general=False):
     """(N, outcome) with mpmath at `dps` decimal digits."""
     with mp.workdps(dps):
-        return count_in(xi, U, W, model, max_bounces, Arithmetic(dps), trace, jitter)
+        return count_in(xi, U, W, model, max_bounces, Arithmetic(dps), trace, jitter, general)
 
 
 def count_double(xi, U, W, model, max_bounces, trace=None):
@@ -262,11 +418,13 @@ def perturbed_launches(xi, U, W, rng):
 class Verdict:
     """The outcome of the acceptance test of one candidate row."""
 
-    def __init__(self, result=None, reason=None, grazing=math.inf, turning=math.inf):
+    def __init__(self, result=None, reason=None, grazing=math.inf, turning=math.inf, slides=0, switching=math.inf):
         self.result = result  # (N, outcome) when accepted
         self.reason = reason  # why not, otherwise
         self.grazing = grazing
         self.turning = turning
+        self.slides = slides  # impacts that slid (section 1b), in the dps 40 run
+        self.switching = switching  # least |psi - psi*|/psi* (section 1b), in the dps 40 run
 
 
 def verify(xi, U, W, model, max_bounces, rng):
@@ -274,7 +432,10 @@ def verify(xi, U, W, model, max_bounces, rng):
     every perturbed launch, that with the impact coefficients rounded to binary64, and that
     of two runs with every coefficient jittered by a relative COEFFICIENT_JITTER and the
     state by a relative STEP_NOISE after every excursion (the others at dps 40). An invalid
-    launch: dps 40 and 80 only (invalid is decided by signs, exactly)."""
+    launch: dps 40 and 80 only (invalid is decided by signs, exactly). A model with a finite
+    mu (section 1b) is also rejected when an impact of the orbit has psi within a relative
+    SWITCHING of its grip/slide threshold psi* (the map's switching surfaces); its jitter
+    covers e, alpha, kappa, 1/(1 + kappa), mu (1 + e)(1 + 1/kappa) and the impact factors."""
     trace = Trace()
     with mp.workdps(DPS_LOW):
         low = count(xi, U, W, model, max_bounces, DPS_LOW, trace)
@@ -283,6 +444,8 @@ def verify(xi, U, W, model, max_bounces, rng):
         return Verdict(low) if high == low else Verdict(reason="precision")
     if low[1] == "missed" and low[0] == max_bounces:
         return Verdict(reason="missed at the cap")
+    if trace.switching <= SWITCHING:
+        return Verdict(reason="grip/slide threshold", grazing=trace.grazing, turning=trace.turning)
     with mp.workdps(DPS_LOW):
         for p in perturbed_launches(xi, U, W, rng):
             if count(p[0], p[1], p[2], model, max_bounces, DPS_LOW) != low:
@@ -296,7 +459,8 @@ def verify(xi, U, W, model, max_bounces, rng):
     high = count(xi, U, W, model, max_bounces, DPS_HIGH)
     if high != low:
         return Verdict(reason="precision", grazing=trace.grazing, turning=trace.turning)
-    return Verdict(low, grazing=trace.grazing, turning=trace.turning)
+    return Verdict(low, grazing=trace.grazing, turning=trace.turning, slides=trace.slides,
+                   switching=trace.switching)
 
 
 # ----------------------------------------------------------------------------- candidates
@@ -572,6 +736,197 @@ def candidates(rng, screen_budget):
     yield from family_long(rng, screen_budget, Quota(4))
 
 
+# ----------------------------------------------------------------------------- candidates: section 1b
+
+TWO_THIRDS = 2.0 / 3.0  # the binary64 0.6666666666666666: a thin spherical shell
+F = Model.friction
+FU = Model.friction_uniform
+FRICTION_MODELS = [
+    FU(0.9, 0.9, 0.5, 0.4),
+    FU(0.9, 0.9, 0.2, 0.4),
+    FU(0.9, 0.9, 1.0, 0.5),
+    FU(0.95, 0.99, 0.5, 0.4),
+    FU(0.95, 0.99, 1.5, TWO_THIRDS),         # long motions (hundreds of bounces), some sliding
+    FU(0.95, 0.99, 3.0, 0.25),               # ... and capped ones (an attracting corner)
+    FU(0.8, 0.6, 0.2, 0.25),
+    FU(0.8, 0.6, 1.0, 0.4),
+    FU(0.99, 0.99, 1.5, 0.4),                # weak dissipation: long motions near the corner
+    FU(0.998, 0.998, 1.5, 0.4),
+    FU(1.0, 1.0, 0.5, 0.4),                  # dissipation by sliding only
+    FU(1.0, 1.0, 1.5, TWO_THIRDS),           # grips on the self-retracing line (psi = 1 + 1/kappa)
+    FU(1.0, 1.0, 3.0, 0.25),
+    F(0.9, 0.9, 0.2, 0.95, 0.99, 1.5, 0.5),  # two materials, or two frictions
+    F(0.95, 0.99, 1.0, 0.8, 0.6, 0.5, 0.4),
+    F(0.9, 0.9, 3.0, 0.9, 0.9, 0.2, TWO_THIRDS),
+    F(0.95, 0.99, 1.5, 0.95, 0.99, 3.0, 0.5),
+    F(0.9, 0.9, math.inf, 0.9, 0.9, 0.5, 0.4),   # one surface without a Coulomb limit
+    F(0.95, 0.99, 0.5, 0.95, 0.99, math.inf, TWO_THIRDS),
+    F(1.0, 1.0, math.inf, 1.0, 1.0, 1.5, 0.4),
+    FU(0.9, 0.9, 0.0, 0.4),                  # smooth surfaces: beta = -1
+    F(1.0, 1.0, 0.0, 1.0, 1.0, 1.5, 0.25),
+    FU(0.9, 0.9, math.inf, TWO_THIRDS),      # the Cross model for other balls
+    FU(1.0, 1.0, math.inf, 0.25),
+    FU(0.95, 0.99, math.inf, 0.5),
+]
+
+
+def general_self_retracing_point(xi, kappa):
+    """The self-retracing motion for e = alpha = 1 and a gripping impact (as
+    self_retracing_point, for any kappa): U = -(1 - 2 xi), W = -(1 - 2 xi)/kappa. Its wall
+    impact has psi = 1 + 1/kappa: it grips when mu >= 1."""
+    return -(1.0 - 2.0 * xi), -(1.0 - 2.0 * xi) / kappa
+
+
+def general_corner_fixed_points(model):
+    """[(U, W)] of the fixed points of G on the corner plane xi = 0 (corner_fixed_point, with
+    the impacts of section 1b), found by Newton's method from a few starts (the map is
+    piecewise smooth: a start converges when the fixed point is off a switching surface)."""
+    found = []
+    with mp.workdps(30):
+        A = Arithmetic(30)
+        wall = Surface(model.e_wall, model.alpha_wall, model.mu_wall, model.inertia, A)
+        floor = Surface(model.e_floor, model.alpha_floor, model.mu_floor, model.inertia, A)
+
+        def residual(U, W):
+            u_p, v_p, W_p = wall.wall(U, mpf(1), W, None)
+            u, v, Wn = floor.floor(u_p, v_p, W_p, None)
+            return [u / v - U, Wn / v - W]
+
+        for start in ((-1, -2.5), (-0.5, -1), (-2, -5), (-1, 1), (-0.3, -3), (-3, -1)):
+            try:
+                U, W = mp.findroot(residual, (mpf(start[0]), mpf(start[1])))
+            except (ValueError, ZeroDivisionError, TypeError):  # no convergence, a singular Jacobian
+                continue
+            if not (U < 0 and wall.wall(U, mpf(1), W, None)[1] < 0):
+                continue
+            if max(abs(r) for r in residual(U, W)) > mpf(10) ** -20:
+                continue
+            p = (float(U), float(W))
+            if all(abs(p[0] - q[0]) + abs(p[1] - q[1]) > 1e-9 for q in found):
+                found.append(p)
+    return found
+
+
+FRICTION_CAPS = [1000, 200, 1000, 500, 200, 100, 1000, 50]
+
+
+def friction_family_invalid(rng):
+    starts = [(0.0, -1.0, 0.0), (0.5, 0.0, 1.0), (-0.25, -0.5, -1.25), (0.3, 2.0, -4.0)]
+    for i, s in enumerate(starts):
+        yield Candidate("invalid", FRICTION_MODELS[3 * i], 1000, *s)
+
+
+def friction_family_random(rng, per_model):
+    """Uniform launches over the region of interest (max_bounces 1000 or 200)."""
+    for model in FRICTION_MODELS:
+        for i in range(per_model):
+            yield Candidate("random", model, (1000, 200)[i % 2], *random_launch(rng))
+
+
+def friction_family_near_wall(rng, per_model):
+    """Launches close to the wall (xi log-uniform in 1e-5 .. 0.2)."""
+    for model in FRICTION_MODELS:
+        for i in range(per_model):
+            xi = math.exp(rng.uniform(math.log(1e-5), math.log(0.2)))
+            _, U, W = random_launch(rng)
+            yield Candidate("near_wall", model, (1000, 200)[i % 2], xi, U, W)
+
+
+def friction_family_grazing_launch(rng, per_model):
+    """Launches that barely reach the wall, xi = 1 - d, d from 1e-3 to 1e-8, and (every fifth
+    model) one that barely misses it, xi = 1 + d (missed, N = 0)."""
+    for i, model in enumerate(FRICTION_MODELS):
+        for _ in range(per_model):
+            _, U, W = random_launch(rng)
+            yield Candidate("grazing_launch", model, 1000, 1.0 - 10.0 ** rng.uniform(-8, -3), U, W)
+        if i % 5 == 0:
+            _, U, W = random_launch(rng)
+            yield Candidate("grazing_launch", model, 1000, 1.0 + 10.0 ** rng.uniform(-8, -3), U, W)
+
+
+def friction_family_garwin(rng, per_model):
+    """e = alpha = 1 on both surfaces: launches near the self-retracing line, at caps from
+    50 to 1000 (quasi-periodic motions while every impact grips; sliding dissipates)."""
+    for model in FRICTION_MODELS:
+        if model.fields() != [1.0, 1.0, 1.0, 1.0]:
+            continue
+        for i in range(per_model):
+            xi0 = rng.uniform(0.02, 0.45)
+            U0, W0 = general_self_retracing_point(xi0, model.inertia)
+            r = min(10.0 ** rng.uniform(-5, -1.5), 0.5 * xi0)
+            yield Candidate("garwin", model, FRICTION_CAPS[i % len(FRICTION_CAPS)], xi0 + rng.uniform(-r, r),
+                            U0 + rng.uniform(-r, r), W0 + rng.uniform(-r, r))
+
+
+class SlideQuota(Quota):
+    """Quota per (model, outcome, N range, whether an impact slid): the binary64 screen's
+    slides (`screened`) until the row is verified, then the mp count's."""
+
+    def open(self, model, n, outcome, slid=False):
+        return self.bins.get((model.key(), outcome, n_range(n), slid), 0) < self.per_bin
+
+    def accept(self, model, n, outcome, slid=False):
+        key = (model.key(), outcome, n_range(n), slid)
+        self.bins[key] = self.bins.get(key, 0) + 1
+
+
+def screen(xi, U, W, model, max_bounces):
+    """(N, outcome, slid) in binary64, for screening."""
+    trace = Trace()
+    n, outcome = count_double(xi, U, W, model, max_bounces, trace)
+    return n, outcome, trace.slides > 0
+
+
+def friction_family_corner(rng, tries, quota):
+    """Launches close to the wall near the fixed points of G on the corner plane xi = 0:
+    long motions into the corner. Screened in binary64 with max_bounces 1000."""
+    for model in FRICTION_MODELS:
+        for U0, W0 in general_corner_fixed_points(model):
+            for _ in range(tries):
+                xi = 10.0 ** rng.uniform(-9, -2)
+                U = U0 * (1 + rng.choice((-1, 1)) * 10.0 ** rng.uniform(-9, -2))
+                W = W0 * (1 + rng.choice((-1, 1)) * 10.0 ** rng.uniform(-9, -2))
+                n, outcome, slid = screen(xi, U, W, model, 1000)
+                if n >= 10 and quota.open(model, n, outcome, slid):
+                    yield Candidate("corner", model, 1000, xi, U, W, quota)
+
+
+def friction_family_long(rng, screen_budget, quota):
+    """Random launches screened in binary64 for long motions (N >= 30, any outcome), with
+    max_bounces 1000."""
+    for model in FRICTION_MODELS:
+        for _ in range(screen_budget):
+            if rng.random() < 0.5:
+                xi, U, W = random_launch(rng)
+            else:
+                xi = math.exp(rng.uniform(math.log(1e-4), math.log(0.5)))
+                _, U, W = random_launch(rng)
+            n, outcome, slid = screen(xi, U, W, model, 1000)
+            if n >= 30 and quota.open(model, n, outcome, slid):
+                yield Candidate("long", model, 1000, xi, U, W, quota)
+
+
+def friction_cap_edges(rng, long_rows):
+    """The cap below long motions already accepted: N - 1, a random cap below N, and 200
+    when N > 200 (all capped)."""
+    for row in long_rows:
+        n, model = row["n"], row["model_obj"]
+        caps = [n - 1, rng.randint(1, n - 1)] + ([200] if n > 200 else [])
+        for cap in caps:
+            if cap >= 1:
+                yield Candidate("cap_edges", model, cap, row["xi"], row["U"], row["W"])
+
+
+def friction_candidates(rng, screen_budget):
+    yield from friction_family_invalid(rng)
+    yield from friction_family_random(rng, 8)
+    yield from friction_family_near_wall(rng, 5)
+    yield from friction_family_grazing_launch(rng, 1)
+    yield from friction_family_garwin(rng, 8)
+    yield from friction_family_corner(rng, screen_budget, SlideQuota(2))
+    yield from friction_family_long(rng, screen_budget, SlideQuota(2))
+
+
 # ----------------------------------------------------------------------------- output
 
 
@@ -587,19 +942,20 @@ def n_range(n):
     return ">=1000"
 
 
-def coverage_table(rows):
+def coverage_table(rows, label="model (e_w,a_w,e_f,a_f)"):
     """Text table: rows per model x outcome x N range."""
     ranges = ["0", "1-9", "10-99", "100-499", "500-999", ">=1000"]
+    width = max([30, len(label)] + [len(",".join("%g" % c for c in r["model"])) for r in rows])
     lines = []
     for outcome in OUTCOMES:
         sel = [r for r in rows if r["outcome"] == outcome]
         if not sel:
             continue
         lines.append("%s (%d rows)" % (outcome, len(sel)))
-        lines.append("  %-30s" % "model (e_w,a_w,e_f,a_f)" + "".join("%9s" % h for h in ranges))
+        lines.append("  %-*s" % (width, label) + "".join("%9s" % h for h in ranges))
         for model in sorted({r["model"] for r in sel}):
             counts = [sum(1 for r in sel if r["model"] == model and n_range(r["n"]) == h) for h in ranges]
-            lines.append("  %-30s" % ",".join("%g" % c for c in model) + "".join("%9d" % c for c in counts))
+            lines.append("  %-*s" % (width, ",".join("%g" % c for c in model)) + "".join("%9d" % c for c in counts))
     return "\n".join(lines)
 
 
@@ -658,6 +1014,82 @@ def generate(out_path, seed, screen_budget, verbose):
     return kept
 
 
+FRICTION_HEADER = ["e_wall", "alpha_wall", "mu_wall", "e_floor", "alpha_floor", "mu_floor", "inertia", "max_bounces",
+                   "xi", "U", "W", "wall_bounces", "outcome", "slides"]
+
+
+def generate_friction(out_path, seed, screen_budget, verbose):
+    """The section 1b reference (mp_friction_counts.csv): as generate, for FRICTION_MODELS,
+    with the number of impacts that slid in the last column."""
+    start = time.time()
+    rng = random.Random(seed)
+    check_rng = random.Random(seed + 1)
+    kept, dropped = [], {}
+    families = {}
+
+    def consider(cand):
+        v = verify(cand.xi, cand.U, cand.W, cand.model, cand.max_bounces, check_rng)
+        fam = families.setdefault(cand.family, [0, 0])
+        fam[0] += 1
+        if v.result is None:
+            dropped[(cand.family, v.reason)] = dropped.get((cand.family, v.reason), 0) + 1
+            return
+        n, outcome = v.result
+        fam[1] += 1
+        if cand.quota is not None:
+            cand.quota.accept(cand.model, n, outcome, v.slides > 0)
+        kept.append({"model": cand.model.key(), "model_obj": cand.model, "max_bounces": cand.max_bounces,
+                     "xi": cand.xi, "U": cand.U, "W": cand.W, "n": n, "outcome": outcome, "slides": v.slides,
+                     "family": cand.family, "grazing": v.grazing, "turning": v.turning,
+                     "switching": v.switching})
+        if verbose:
+            print("%-15s %-40s %-45s max %4d -> %4d %-7s slides %d" % (
+                cand.family, cand.model.key(), (cand.xi, cand.U, cand.W), cand.max_bounces, n, outcome, v.slides),
+                file=sys.stderr)
+
+    for cand in friction_candidates(rng, screen_budget):
+        consider(cand)
+    # The cap below some of the long motions found: 30 that slid, 10 that did not.
+    long_rows = [r for r in kept if r["outcome"] in ("left", "missed") and r["n"] >= 10]
+    slid = [r for r in long_rows if r["slides"] > 0]
+    gripped = [r for r in long_rows if r["slides"] == 0]
+    sample = rng.sample(slid, min(30, len(slid))) + rng.sample(gripped, min(10, len(gripped)))
+    for cand in friction_cap_edges(rng, sample):
+        consider(cand)
+    seconds = time.time() - start
+    with open(out_path, "w", newline="") as f:
+        f.write("# Generated by tests/reference/mp_reference.py --friction --seed %d (mpmath %s): %d rows (SPEC 1b: "
+                "Walton friction mu per surface, inertia kappa), each the same at dps %d and %d, for launches "
+                "perturbed by %g, coefficients (e, alpha, mu, kappa and derived factors) rounded to binary64 or moved "
+                "by %g, states moved by %g per excursion (relative), no impact within a relative %g of its grip/slide "
+                "threshold; slides = impacts with beta < alpha\n" % (
+                    seed, mp_version(), len(kept), DPS_LOW, DPS_HIGH, PERTURBATION, COEFFICIENT_JITTER, STEP_NOISE,
+                    SWITCHING))
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(FRICTION_HEADER)
+        for r in kept:
+            w.writerow([fmt(c) for c in r["model_obj"].friction_fields()] +
+                       [r["max_bounces"], fmt(r["xi"]), fmt(r["U"]), fmt(r["W"]), r["n"], r["outcome"], r["slides"]])
+    print("wrote %d rows to %s in %.1f s" % (len(kept), out_path, seconds))
+    print("candidates per family (kept/tried): " +
+          ", ".join("%s %d/%d" % (k, v[1], v[0]) for k, v in families.items()))
+    print("dropped: " + (", ".join("%s: %d (%s)" % (k[0], c, k[1]) for k, c in sorted(dropped.items())) or "none"))
+    print(coverage_table(kept, "model (e,a,mu wall; floor; kappa)"))
+    print("rows per outcome: " + ", ".join("%s %d" % (o, sum(1 for r in kept if r["outcome"] == o))
+                                           for o in OUTCOMES))
+    print("rows with slides > 0: %d (left %d, missed %d, capped %d; N >= 100: %d)" % (
+        sum(1 for r in kept if r["slides"] > 0),
+        *[sum(1 for r in kept if r["slides"] > 0 and r["outcome"] == o) for o in ("left", "missed", "capped")],
+        sum(1 for r in kept if r["slides"] > 0 and r["n"] >= 100)))
+    print("least relative distance |psi - psi*|/psi* of an impact to its grip/slide threshold: %.3g; rows "
+          "with one below 1e-6: %d" % (min(r["switching"] for r in kept),
+                                       sum(1 for r in kept if r["switching"] < 1e-6)))
+    disagree = [r for r in kept if count_double(r["xi"], r["U"], r["W"], r["model_obj"], r["max_bounces"]) !=
+                (r["n"], r["outcome"])]
+    print("rows where this module's binary64 count disagrees: %d" % len(disagree))
+    return kept
+
+
 def mp_version():
     import mpmath
 
@@ -686,18 +1118,130 @@ def check_canonical(path, max_bounces=1000):
     return rows, bad
 
 
+def check_cross(path):
+    """Recompute every row of mp_counts.csv (the Cross model) with the impacts of section 1b
+    (mu = inf, kappa = 0.4): they must be section 1's. Returns the rows that disagree."""
+    bad = []
+    rows = read_rows(path)
+    for row in rows:
+        model = Model(row["e_wall"], row["alpha_wall"], row["e_floor"], row["alpha_floor"])
+        got = count(float(row["xi"]), float(row["U"]), float(row["W"]), model, int(row["max_bounces"]),
+                    general=True)
+        if got != (int(row["wall_bounces"]), row["outcome"]):
+            bad.append((row, got))
+    return rows, bad
+
+
+def check_friction(path):
+    """Recompute every row of mp_friction_counts.csv at dps 40 (N, outcome and slides)."""
+    bad = []
+    rows = read_rows(path)
+    for row in rows:
+        model = Model.friction(*(float(row[k]) for k in FRICTION_HEADER[:7]))
+        trace = Trace()
+        got = count(float(row["xi"]), float(row["U"]), float(row["W"]), model, int(row["max_bounces"]),
+                    trace=trace)
+        if got + (trace.slides,) != (int(row["wall_bounces"]), row["outcome"], int(row["slides"])):
+            bad.append((row, got + (trace.slides,)))
+    return rows, bad
+
+
+def self_test(trials=2000, seed=1):
+    """The invariants of SPEC 1b on random impacts, at dps 50 (returns a list of failures):
+    kappa W + v (wall) and kappa W - u (floor) conserved; the contact velocity s -> -beta s;
+    kinetic energy u^2 + v^2 + kappa W^2 never grows (e, |alpha| <= 1); a sliding impact's
+    tangential impulse is mu times the normal one; beta = alpha with mu = inf, and then,
+    with kappa = 2/5, section 1's coefficients (5 - 2 alpha)/7, 2 (1 + alpha)/7, ..."""
+    rng = random.Random(seed)
+    fails = []
+    with mp.workdps(50):
+        A = Arithmetic(50)
+        tol = mpf(10) ** -40
+
+        def check(ok, what):
+            if not ok:
+                fails.append(what)
+
+        for _ in range(trials):
+            e = rng.choice((1.0, rng.uniform(0.05, 1.0)))
+            alpha = rng.choice((1.0, -1.0, rng.uniform(-1.0, 1.0)))
+            mu = rng.choice((0.0, math.inf, math.exp(rng.uniform(math.log(0.05), math.log(5.0)))))
+            kappa = rng.choice((0.4, TWO_THIRDS, rng.uniform(0.01, TWO_THIRDS)))
+            S = Surface(e, alpha, mu, kappa, A)
+            k = mpf(kappa)
+            u, v, W = -mpf(rng.uniform(0.01, 5.0)), mpf(rng.uniform(-5.0, 5.0)), mpf(rng.uniform(-10.0, 10.0))
+            what = (e, alpha, mu, kappa, float(u), float(v), float(W))
+            trace = Trace()
+            u_p, v_p, W_p = S.wall(u, v, W, trace)  # wall: normal u, tangential v
+            check(abs((k * W_p + v_p) - (k * W + v)) < tol, ("wall angular momentum", what))
+            check(abs(u_p + mpf(e) * u) < tol, ("wall normal", what))
+            energy = u * u + v * v + k * W * W
+            check(u_p * u_p + v_p * v_p + k * W_p * W_p <= energy * (1 + tol), ("wall energy", what))
+            s, s_p = v - W, v_p - W_p
+            if trace.slides:
+                check(abs(abs(v_p - v) - mpf(mu) * (1 + mpf(e)) * (-u)) < tol, ("wall Coulomb", what))
+                beta = -s_p / s  # s -> -beta s, -1 <= beta < alpha
+                check(-1 - tol <= beta < alpha, ("wall slide beta", what))
+            else:
+                check(abs(s_p + mpf(alpha) * s) < tol * (1 + abs(s)), ("wall grip", what))
+            if math.isinf(mu):
+                check(not trace.slides, ("mu = inf slid", what))
+            # floor: normal v_f < 0, tangential u
+            v_f = -abs(v) - mpf(0.01)
+            trace = Trace()
+            u_n, v_n, W_n = S.floor(u, v_f, W, trace)
+            check(abs((k * W_n - u_n) - (k * W - u)) < tol, ("floor angular momentum", what))
+            check(abs(v_n + mpf(e) * v_f) < tol, ("floor normal", what))
+            energy = u * u + v_f * v_f + k * W * W
+            check(u_n * u_n + v_n * v_n + k * W_n * W_n <= energy * (1 + tol), ("floor energy", what))
+            s, s_p = u + W, u_n + W_n
+            if trace.slides:
+                check(abs(abs(u_n - u) - mpf(mu) * (1 + mpf(e)) * (-v_f)) < tol, ("floor Coulomb", what))
+                beta = -s_p / s
+                check(-1 - tol <= beta < alpha, ("floor slide beta", what))
+            else:
+                check(abs(s_p + mpf(alpha) * s) < tol * (1 + abs(s)), ("floor grip", what))
+            if math.isinf(mu) and kappa == 0.4:
+                # section 1's coefficients, with kappa the binary64 0.4 (not exactly 2/5)
+                _, c_ss, c_sW, c_Ws, c_WW = _surface(e, alpha, A)
+                tol1 = mpf(1e-15)
+                check(abs(v_p - (c_sW * W + c_ss * v)) < tol1 * 20 and
+                      abs(W_p - (c_Ws * v + c_WW * W)) < tol1 * 20, ("section 1 wall", what))
+                check(abs(u_n - (c_ss * u - c_sW * W)) < tol1 * 20 and
+                      abs(W_n - (c_WW * W - c_Ws * u)) < tol1 * 20, ("section 1 floor", what))
+    return fails
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", help="write the reference CSV here")
+    p.add_argument("--friction", action="store_true",
+                   help="with --out: the section 1b reference (mp_friction_counts.csv) instead of mp_counts.csv")
     p.add_argument("--seed", type=int, default=24)
-    p.add_argument("--screen-budget", type=int, default=1500,
-                   help="binary64 launches screened per model for long motions (default 1500)")
+    p.add_argument("--screen-budget", type=int, default=None,
+                   help="binary64 launches screened per model for long motions (default 1500; --friction: 600)")
     p.add_argument("--check-canonical", nargs="?", const=os.path.join(HERE, "canonical_counts.csv"),
                    metavar="CSV", help="recompute canonical_counts.csv (default: the one next to this file)")
+    p.add_argument("--check-cross", nargs="?", const=os.path.join(HERE, "mp_counts.csv"), metavar="CSV",
+                   help="recompute mp_counts.csv with the impacts of SPEC 1b (mu = inf, kappa = 0.4)")
+    p.add_argument("--check-friction", nargs="?", const=os.path.join(HERE, "mp_friction_counts.csv"),
+                   metavar="CSV", help="recompute mp_friction_counts.csv at dps 40 (N, outcome, slides)")
+    p.add_argument("--self-test", action="store_true", help="check the invariants of SPEC 1b's impacts")
     p.add_argument("--count", nargs=8, metavar=("E_W", "A_W", "E_F", "A_F", "MAX", "XI", "U", "W"),
                    help="count one launch at dps 40 and 80")
+    p.add_argument("--count-friction", nargs=11,
+                   metavar=("E_W", "A_W", "MU_W", "E_F", "A_F", "MU_F", "INERTIA", "MAX", "XI", "U", "W"),
+                   help="count one launch of a section 1b model at dps 40 and 80 (N, outcome, slides)")
     p.add_argument("-v", "--verbose", action="store_true")
     a = p.parse_args(argv)
+    status = 0
+    if a.self_test:
+        fails = self_test()
+        for what in fails[:20]:
+            print("FAIL %s" % (what,))
+        print("self-test of SPEC 1b's impacts: %d failures" % len(fails))
+        if fails:
+            status = 1
     if a.check_canonical:
         rows, bad = check_canonical(a.check_canonical)
         for row, got in bad:
@@ -705,16 +1249,41 @@ def main(argv=None):
         print("canonical_counts.csv: %d rows, %d disagree" % (len(rows), len(bad)))
         if bad:
             return 1
+    if a.check_cross:
+        rows, bad = check_cross(a.check_cross)
+        for row, got in bad:
+            print("MISMATCH %s: section 1b gives %s" % (dict(row), got))
+        print("%s with SPEC 1b's impacts: %d rows, %d disagree" % (a.check_cross, len(rows), len(bad)))
+        if bad:
+            status = 1
+    if a.check_friction:
+        rows, bad = check_friction(a.check_friction)
+        for row, got in bad:
+            print("MISMATCH %s: mp gives %s" % (dict(row), got))
+        print("%s: %d rows, %d disagree" % (a.check_friction, len(rows), len(bad)))
+        if bad:
+            status = 1
     if a.count:
         model = Model(*a.count[:4])
         args = (float(a.count[5]), float(a.count[6]), float(a.count[7]), model, int(a.count[4]))
         print("dps %d: %s; dps %d: %s" % (DPS_LOW, count(*args, DPS_LOW), DPS_HIGH, count(*args, DPS_HIGH)))
+    if a.count_friction:
+        c = a.count_friction
+        model = Model.friction(*(float(x) for x in c[:7]))
+        args = (float(c[8]), float(c[9]), float(c[10]), model, int(c[7]))
+        for dps in (DPS_LOW, DPS_HIGH):
+            trace = Trace()
+            print("dps %d: %s, slides %d" % (dps, count(*args, dps, trace), trace.slides))
     if a.out:
-        generate(a.out, a.seed, a.screen_budget, a.verbose)
-    if not (a.out or a.count or a.check_canonical):
+        if a.friction:
+            generate_friction(a.out, a.seed, 600 if a.screen_budget is None else a.screen_budget, a.verbose)
+        else:
+            generate(a.out, a.seed, 1500 if a.screen_budget is None else a.screen_budget, a.verbose)
+    if not (a.out or a.count or a.count_friction or a.check_canonical or a.check_cross or a.check_friction or
+            a.self_test):
         p.print_usage()
         return 2
-    return 0
+    return status
 
 
 if __name__ == "__main__":

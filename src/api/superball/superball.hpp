@@ -25,10 +25,14 @@ namespace superball::api {
 // The library's version ("0.1.0") and where it was built from (its git commit).
 std::string version();
 
-// The impact law's coefficients (SPEC.md section 1): e and alpha for both surfaces, or each
-// surface's own (e_wall, alpha_wall, e_floor, alpha_floor take precedence).
+// The impact law's coefficients (SPEC.md sections 1 and 1b): e and alpha for both surfaces,
+// or each surface's own (e_wall, alpha_wall, e_floor, alpha_floor take precedence); the
+// Coulomb friction coefficient mu likewise (default infinite: the Cross model) and the
+// ball's moment of inertia over m a^2 (default 0.4, a solid ball).
 struct Coefficients {
     std::optional<double> e, alpha, e_wall, alpha_wall, e_floor, alpha_floor;
+    // Initialised, so that aggregates written before them ({e, alpha}) need not name them.
+    std::optional<double> mu = std::nullopt, mu_wall = std::nullopt, mu_floor = std::nullopt, inertia = std::nullopt;
 };
 
 // How a launch's motion ended (SPEC.md section 3).

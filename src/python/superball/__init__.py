@@ -134,10 +134,12 @@ def _kernel(kernel):
     return kernel
 
 
-def _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor):
-    return dict(e=_real("e", e), alpha=_real("alpha", alpha), e_wall=_real("e_wall", e_wall),
-                alpha_wall=_real("alpha_wall", alpha_wall), e_floor=_real("e_floor", e_floor),
-                alpha_floor=_real("alpha_floor", alpha_floor))
+def _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu=None, mu_wall=None, mu_floor=None, inertia=None):
+    """The coefficients as given (None: not given), for _core, which checks them as the
+    command line does (SPEC.md 1b: mu defaults to infinite, inertia to 0.4)."""
+    given = dict(e=e, alpha=alpha, e_wall=e_wall, alpha_wall=alpha_wall, e_floor=e_floor, alpha_floor=alpha_floor, mu=mu,
+                 mu_wall=mu_wall, mu_floor=mu_floor, inertia=inertia)
+    return {key: _real(key, value) for key, value in given.items()}
 
 
 def _coordinate(name, value):
@@ -175,7 +177,8 @@ def _call_text(function, positional, keywords):
 
 
 def count(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None, radius=None, e=None, alpha=None,
-          e_wall=None, alpha_wall=None, e_floor=None, alpha_floor=None, max_bounces=1000, threads=None, kernel=None):
+          e_wall=None, alpha_wall=None, e_floor=None, alpha_floor=None, mu=None, mu_wall=None, mu_floor=None,
+          inertia=None, max_bounces=1000, threads=None, kernel=None):
     """Wall bounces and outcome of launches, at the speed of the vectorised kernel.
 
     The start is canonical, count(xi, U, W, ...), or physical, count(x=..., u=..., v=...,
@@ -195,6 +198,10 @@ def count(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None
         e, alpha   normal (0 < e <= 1) and tangential (-1 <= alpha <= 1; -1 smooth, 1
                    perfectly rough) coefficients of restitution of both surfaces;
         e_wall, alpha_wall, e_floor, alpha_floor   per surface (override e, alpha)
+        mu, mu_wall, mu_floor   Coulomb friction coefficient (Walton's law, SPEC.md 1b;
+                   0 <= mu, default inf: the Cross model), both surfaces or per surface
+        inertia    the ball's moment of inertia over m a^2 (0 < inertia <= 2/3; default
+                   0.4, a solid ball; 2/3 a thin shell)
         max_bounces   wall impacts after which a launch still bouncing is "capped"
                    (1 to 2^32 - 1, default 1000)
         threads    counting threads (default None: every core this process may use)
@@ -218,7 +225,7 @@ def count(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None
     >>> superball.count(0.05, -1, -2, e=0.9, alpha=0.9)
     Counts(wall_bounces=8, outcome=Outcome.left)
     """
-    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor)
+    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall, mu_floor, inertia)
     physical, start, g, radius, max_bounces = _one_start(dict(xi=xi, U=U, W=W, x=x, u=u, v=v, omega=omega), g, radius,
                                                          model, max_bounces)
     threads, kernel = _threads(threads), _kernel(kernel)
@@ -237,7 +244,8 @@ def count(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None
 
 
 def trajectory(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g=None, radius=None, e=None,
-               alpha=None, e_wall=None, alpha_wall=None, e_floor=None, alpha_floor=None, max_bounces=1000, samples=0):
+               alpha=None, e_wall=None, alpha_wall=None, e_floor=None, alpha_floor=None, mu=None, mu_wall=None,
+               mu_floor=None, inertia=None, max_bounces=1000, samples=0):
     """Every impact of one launch: a Trajectory, a dict of NumPy arrays with the columns of
     `superball trajectory --format csv`.
 
@@ -257,7 +265,7 @@ def trajectory(xi=None, U=None, W=None, *, x=None, u=None, v=None, omega=None, g
     Attributes: wall_bounces (total), outcome (an Outcome, equal to count()'s), truncated,
     units, g, radius, start (the canonical xi, U, W).
     """
-    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor)
+    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall, mu_floor, inertia)
     _, start, _, _, max_bounces = _one_start(dict(xi=xi, U=U, W=W, x=x, u=u, v=v, omega=omega), g, radius, model,
                                              max_bounces)
     values = {name: _real(name, value) for name, value in start.items()}
@@ -281,8 +289,8 @@ _CYCLE_COLUMNS = ("period", "xi", "U", "W", "lambda", "eig1", "eig2", "eig3", "s
                   "residual")
 
 
-def fixed_points(*, e=None, alpha=None, e_wall=None, alpha_wall=None, e_floor=None, alpha_floor=None, period=1,
-                 starts=2000, seed=1, corner=False):
+def fixed_points(*, e=None, alpha=None, e_wall=None, alpha_wall=None, e_floor=None, alpha_floor=None, mu=None,
+                 mu_wall=None, mu_floor=None, inertia=None, period=1, starts=2000, seed=1, corner=False):
     """Fixed points and cycles of the canonical map G (self-similar motions), as
     `superball fixed-points` finds them: Newton's method on G^k, k = 1..period, from
     `starts` seeded starts (seed: std::mt19937_64), in 0 < xi < 1, U < 0, and with
@@ -297,7 +305,7 @@ def fixed_points(*, e=None, alpha=None, e_wall=None, alpha_wall=None, e_floor=No
     residual (relative |G^k(s) - s|, at most 1e-10); and "points": the cycle's k points,
     one (k, 3) array per cycle.
     """
-    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor)
+    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall, mu_floor, inertia)
     period = _integer("period", period, -2**31, 2**31 - 1, "1 to 8")
     starts = _integer("starts", starts, -2**63, 2**63 - 1, "starts >= 1")
     seed = _integer("seed", seed, 0, 2**64 - 1, "0 to 2^64 - 1")
@@ -336,7 +344,7 @@ def _table(rows, columns):
 
 
 def continue_branch(*, param, min, max, e=None, alpha=None, e_wall=None, alpha_wall=None, e_floor=None,
-                    alpha_floor=None, start=None, period=1, starts=2000, seed=1, corner=False, step=None,
+                    alpha_floor=None, mu=None, mu_wall=None, mu_floor=None, inertia=None, start=None, period=1, starts=2000, seed=1, corner=False, step=None,
                     max_step=0.05, min_step=1e-7, max_points=2000, curve=None, curve_min=None, curve_max=None,
                     curve_step=0.005, curve_max_step=0.02, curve_max_points=400):
     """Branches of cycles of G followed in one coefficient, as `superball continue` prints
@@ -364,7 +372,7 @@ def continue_branch(*, param, min, max, e=None, alpha=None, e_wall=None, alpha_w
                     event, period, corner, <param>, <curve>, xi, U, W, lambda, ev1_re ...,
                     stability, note), and "curve_ends": per curve, why each end stopped
     """
-    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor)
+    model = _model(e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall, mu_floor, inertia)
     if not isinstance(param, str):
         raise TypeError(f"param must be a coefficient's name, not {param!r}")
     if curve is not None and not isinstance(curve, str):

@@ -5,8 +5,8 @@ from typing import Any, Optional, Sequence
 import numpy as np
 import numpy.typing as npt
 
-# The model's coefficients (e, alpha, e_wall, alpha_wall, e_floor, alpha_floor): each a
-# float, or None where not given; no other key.
+# The model's coefficients (e, alpha, e_wall, alpha_wall, e_floor, alpha_floor, mu, mu_wall,
+# mu_floor, inertia): each a float, or None where not given; no other key.
 _Model = dict[str, Optional[float]]
 
 version: str
