@@ -293,16 +293,24 @@ hid_t driver()
 PlacedChunks::PlacedChunks(const std::filesystem::path& path) : state_(std::make_unique<State>())
 {
     state_->data_end = std::filesystem::file_size(path);
+    // The log's header (magic, then the file's size) is written under another name and the
+    // log renamed into place: a run killed before the rename leaves no log, one killed after
+    // leaves a whole header. (Written in place, a run killed between its two writes left a
+    // log with the magic alone, which the next run could neither apply nor ignore.)
     const std::filesystem::path undo = undo_path(path);
-    state_->undo = ::open(undo.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (state_->undo < 0) throw h5::Error("cannot create " + undo.string() + ": " + std::strerror(errno));
+    const std::filesystem::path fresh = unfinished_undo_path(path);
+    state_->undo = ::open(fresh.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (state_->undo < 0) throw h5::Error("cannot create " + fresh.string() + ": " + std::strerror(errno));
+    char header[sizeof undo_magic + 8];
     const std::uint64_t size = state_->data_end;
-    if (!write_all(state_->undo, undo_magic, sizeof undo_magic, 0) || !write_all(state_->undo, &size, 8, sizeof undo_magic)) {
+    std::memcpy(header, undo_magic, sizeof undo_magic);
+    std::memcpy(header + sizeof undo_magic, &size, 8);
+    if (!write_all(state_->undo, header, sizeof header, 0) || ::rename(fresh.c_str(), undo.c_str()) != 0) {
         const std::string why = std::strerror(errno);
         ::close(state_->undo);
         // Nothing of the file has changed yet: the log, unfinished, would only stand in the
         // way of a resume (it is not an undo log a resume can read).
-        ::unlink(undo.c_str());
+        ::unlink(fresh.c_str());
         throw h5::Error("cannot write " + undo.string() + ": " + why);
     }
     const h5::Id fapl = h5::file_access(0);
@@ -315,6 +323,13 @@ PlacedChunks::~PlacedChunks()
 {
     file_ = h5::Id();  // closed before the log it writes to
     if (state_->undo >= 0) ::close(state_->undo);
+}
+
+std::filesystem::path PlacedChunks::unfinished_undo_path(const std::filesystem::path& path)
+{
+    std::filesystem::path p = undo_path(path);
+    p += ".new";
+    return p;
 }
 
 std::filesystem::path PlacedChunks::undo_path(const std::filesystem::path& path)
@@ -338,6 +353,7 @@ void PlacedChunks::discard_undo(const std::filesystem::path& path)
 {
     std::error_code ec;
     std::filesystem::remove(undo_path(path), ec);
+    std::filesystem::remove(unfinished_undo_path(path), ec);
 }
 
 bool PlacedChunks::undo_interrupted_changes(const std::filesystem::path& path)
@@ -360,8 +376,20 @@ bool PlacedChunks::undo_interrupted_changes(const std::filesystem::path& path)
     }
     std::uint64_t size = 0;
     char magic[sizeof undo_magic] = {};
-    bool ok = read_all(log, magic, sizeof magic, 0) && std::memcmp(magic, undo_magic, sizeof magic) == 0 &&
-              read_all(log, &size, 8, sizeof undo_magic);
+    if (!read_all(log, magic, sizeof magic, 0) || std::memcmp(magic, undo_magic, sizeof magic) != 0) {
+        ::close(fd);
+        ::close(log);
+        throw fail("it does not start as an undo log");
+    }
+    if (!read_all(log, &size, 8, sizeof undo_magic)) {
+        // The header cut short (a run killed while writing it in place, as superball did
+        // before the rename): it is written before the file is touched, so nothing changed.
+        ::close(fd);
+        ::close(log);
+        std::filesystem::remove(undo, ec);
+        return false;
+    }
+    bool ok = true;
     off_t at = sizeof undo_magic + 8;
     // Records in the order written (a record cut short ends the log), applied last first:
     // a range written twice (the superblock, at open and at close) gets its first bytes.

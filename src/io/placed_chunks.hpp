@@ -54,6 +54,9 @@ public:
     // adds after them.
     static void cover(const std::filesystem::path& path);
     static std::filesystem::path undo_path(const std::filesystem::path& path);
+    // Where the log's header is written before the log is renamed to undo_path (a run killed
+    // in between may leave it; discard_undo removes it too).
+    static std::filesystem::path unfinished_undo_path(const std::filesystem::path& path);
     static void discard_undo(const std::filesystem::path& path);
     // Whether `path` is an undo log (its first bytes say so).
     static bool is_undo_log(const std::filesystem::path& path);
