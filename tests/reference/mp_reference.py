@@ -1242,20 +1242,15 @@ def main(argv=None):
         print("canonical_counts.csv: %d rows, %d disagree" % (len(rows), len(bad)))
         if bad:
             return 1
-    if a.check_cross:
-        rows, bad = check_cross(a.check_cross)
-        for row, got in bad:
-            print("MISMATCH %s: section 1b gives %s" % (dict(row), got))
-        print("%s with SPEC 1b's impacts: %d rows, %d disagree" % (a.check_cross, len(rows), len(bad)))
-        if bad:
-            status = 1
-    if a.check_friction:
-        rows, bad = check_friction(a.check_friction)
-        for row, got in bad:
-            print("MISMATCH %s: mp gives %s" % (dict(row), got))
-        print("%s: %d rows, %d disagree" % (a.check_friction, len(rows), len(bad)))
-        if bad:
-            status = 1
+    for path, check, what, label in ((a.check_cross, check_cross, "section 1b", " with SPEC 1b's impacts"),
+                                     (a.check_friction, check_friction, "mp", "")):
+        if path:
+            rows, bad = check(path)
+            for row, got in bad:
+                print("MISMATCH %s: %s gives %s" % (dict(row), what, got))
+            print("%s%s: %d rows, %d disagree" % (path, label, len(rows), len(bad)))
+            if bad:
+                status = 1
     if a.count:
         model = Model(*a.count[:4])
         args = (float(a.count[5]), float(a.count[6]), float(a.count[7]), model, int(a.count[4]))
