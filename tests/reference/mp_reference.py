@@ -640,16 +640,22 @@ def family_corner(rng, tries, quota):
                 yield Candidate("corner", model, 2000, xi, U, W, quota)
 
 
+def long_launch(rng):
+    """A launch for the long-motion screens: half the time uniform in xi, half the time
+    log-uniform in xi from 1e-4 to 0.5 (near the wall, where motions last)."""
+    if rng.random() < 0.5:
+        return random_launch(rng)
+    xi = math.exp(rng.uniform(math.log(1e-4), math.log(0.5)))
+    _, U, W = random_launch(rng)
+    return xi, U, W
+
+
 def family_long(rng, screen_budget, quota):
     """Random launches screened in binary64 for long motions (N >= 50, any outcome) in every
     model, with max_bounces 2000 so that escapes after hundreds of bounces show."""
     for model in MODELS:
         for _ in range(screen_budget):
-            if rng.random() < 0.5:
-                xi, U, W = random_launch(rng)
-            else:
-                xi = math.exp(rng.uniform(math.log(1e-4), math.log(0.5)))
-                _, U, W = random_launch(rng)
+            xi, U, W = long_launch(rng)
             n, outcome = count_double(xi, U, W, model, 2000)
             if n >= 50 and quota.open(model, n, outcome):
                 yield Candidate("long", model, 2000, xi, U, W, quota)
@@ -896,11 +902,7 @@ def friction_family_long(rng, screen_budget, quota):
     max_bounces 1000."""
     for model in FRICTION_MODELS:
         for _ in range(screen_budget):
-            if rng.random() < 0.5:
-                xi, U, W = random_launch(rng)
-            else:
-                xi = math.exp(rng.uniform(math.log(1e-4), math.log(0.5)))
-                _, U, W = random_launch(rng)
+            xi, U, W = long_launch(rng)
             n, outcome, slid = screen(xi, U, W, model, 1000)
             if n >= 30 and quota.open(model, n, outcome, slid):
                 yield Candidate("long", model, 1000, xi, U, W, quota)
