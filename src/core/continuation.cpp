@@ -759,27 +759,9 @@ bool parameter_defined(const Model& m, Parameter p)
     return true;
 }
 
-bool parameter_in_range(Parameter p, double value)
-{
-    switch (kind_of(p)) {
-        case Kind::e: return e_in_range(value);
-        case Kind::alpha: return alpha_in_range(value);
-        case Kind::mu: return mu_in_range(value);
-        case Kind::inertia: return inertia_in_range(value);
-    }
-    return false;
-}
+bool parameter_in_range(Parameter p, double value) { return coefficient_in_range(name(p), value); }
 
-const char* parameter_range_text(Parameter p)
-{
-    switch (kind_of(p)) {
-        case Kind::e: return e_range_text;
-        case Kind::alpha: return alpha_range_text;
-        case Kind::mu: return mu_range_text;
-        case Kind::inertia: return inertia_range_text;
-    }
-    return "";
-}
+const char* parameter_range_text(Parameter p) { return coefficient_range_text(name(p)); }
 
 Model ParameterPath::at(double s) const
 {

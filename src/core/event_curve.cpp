@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "input.hpp"
 
@@ -24,9 +25,8 @@ struct Plane {
 // Coefficients (q1, q2) + s (n1, n2), the others those of the model.
 ParameterPath line(const Plane& plane, double q1, double q2, double n1, double n2)
 {
-    const Model zero = no_change;
     return {with_parameter(with_parameter(plane.model, plane.first, q1), plane.second, q2),
-            with_parameter(with_parameter(zero, plane.first, n1), plane.second, n2), "s"};
+            with_parameter(with_parameter(no_change, plane.first, n1), plane.second, n2), "s"};
 }
 
 struct Found {
@@ -168,11 +168,10 @@ EventCurvePoint curve_point(const Found& f)
 
 bool independent(Parameter a, Parameter b)
 {
-    const Model zero = no_change;
-    const Model ma = with_parameter(zero, a, 1.0), mb = with_parameter(zero, b, 1.0);
-    return ma.wall.e * mb.wall.e + ma.wall.alpha * mb.wall.alpha + ma.floor.e * mb.floor.e +
-               ma.floor.alpha * mb.floor.alpha ==
-           0.0;
+    // Every coefficient each moves (mu and inertia too: mu and mu_wall both move the wall's).
+    const auto ma = model_coefficients(with_parameter(no_change, a, 1.0));
+    const auto mb = model_coefficients(with_parameter(no_change, b, 1.0));
+    return std::inner_product(ma.begin(), ma.end(), mb.begin(), 0.0) == 0.0;
 }
 
 std::optional<EventCurve> continue_event(const Branch& branch, std::size_t index, const Model& model, Parameter first,

@@ -19,11 +19,8 @@ std::string model_text(const Model& m)
 {
     std::string out = "e_wall " + format_double(m.wall.e) + " alpha_wall " + format_double(m.wall.alpha) + " e_floor " +
                       format_double(m.floor.e) + " alpha_floor " + format_double(m.floor.alpha);
-    const Model defaults{};
-    if (m.wall.mu != defaults.wall.mu || m.floor.mu != defaults.floor.mu) {
-        out += " mu_wall " + format_double(m.wall.mu) + " mu_floor " + format_double(m.floor.mu);
-    }
-    if (m.inertia != defaults.inertia) out += " inertia " + format_double(m.inertia);
+    if (m.frictional()) out += " mu_wall " + format_double(m.wall.mu) + " mu_floor " + format_double(m.floor.mu);
+    if (m.inertia != solid_ball_inertia) out += " inertia " + format_double(m.inertia);
     return out;
 }
 

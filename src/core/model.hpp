@@ -1,7 +1,10 @@
 // Material model of the floor-wall superball problem (SPEC.md sections 1 and 1b).
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <limits>
+#include <string_view>
 
 namespace superball {
 
@@ -50,5 +53,33 @@ inline constexpr const char* alpha_range_text = "-1 <= alpha <= 1";
 inline constexpr const char* mu_range_text = "0 <= mu <= inf (inf: no friction limit, the Cross model)";
 // 2/3 as the double it is compared with: 0.6666666666666666 is accepted, 0.6667 is not.
 inline constexpr const char* inertia_range_text = "0 < inertia <= 2/3 (0.6666666666666666, a thin shell)";
+
+// A coefficient's physical range by its name (e, e_wall, alpha, alpha_floor, mu, mu_wall,
+// inertia, ...), for the checks and messages of every layer that names coefficients (job
+// files, results, continuation parameters).
+constexpr bool coefficient_in_range(std::string_view name, double value)
+{
+    if (name.starts_with("alpha")) return alpha_in_range(value);
+    if (name.starts_with("mu")) return mu_in_range(value);
+    if (name == "inertia") return inertia_in_range(value);
+    return e_in_range(value);
+}
+
+constexpr const char* coefficient_range_text(std::string_view name)
+{
+    if (name.starts_with("alpha")) return alpha_range_text;
+    if (name.starts_with("mu")) return mu_range_text;
+    if (name == "inertia") return inertia_range_text;
+    return e_range_text;
+}
+
+// Every coefficient of a model, one value each, in the order of job/job.hpp's
+// model_coefficient_names(): e_wall, alpha_wall, e_floor, alpha_floor, mu_wall, mu_floor,
+// inertia.
+inline constexpr std::size_t model_coefficient_count = 7;
+constexpr std::array<double, model_coefficient_count> model_coefficients(const Model& m)
+{
+    return {m.wall.e, m.wall.alpha, m.floor.e, m.floor.alpha, m.wall.mu, m.floor.mu, m.inertia};
+}
 
 }  // namespace superball

@@ -10,7 +10,9 @@ std::vector<std::string> coordinate_names(Coordinates c)
 
 std::vector<std::string> coefficient_names()
 {
-    return {"e", "alpha", "e_wall", "alpha_wall", "e_floor", "alpha_floor", "mu", "mu_wall", "mu_floor", "inertia"};
+    std::vector<std::string> names;
+    for (const ModelKey& key : model_input_keys) names.emplace_back(key.name);
+    return names;
 }
 
 std::vector<std::string> model_coefficient_names()
@@ -18,28 +20,8 @@ std::vector<std::string> model_coefficient_names()
     return {"e_wall", "alpha_wall", "e_floor", "alpha_floor", "mu_wall", "mu_floor", "inertia"};
 }
 
-bool coefficient_in_range(std::string_view name, double value)
-{
-    if (name.starts_with("alpha")) return alpha_in_range(value);
-    if (name.starts_with("mu")) return mu_in_range(value);
-    if (name == "inertia") return inertia_in_range(value);
-    return e_in_range(value);
-}
-
-const char* coefficient_range_text(std::string_view name)
-{
-    if (name.starts_with("alpha")) return alpha_range_text;
-    if (name.starts_with("mu")) return mu_range_text;
-    if (name == "inertia") return inertia_range_text;
-    return e_range_text;
-}
-
 bool is_friction_coefficient(std::string_view name) { return name.starts_with("mu") || name == "inertia"; }
 
-std::array<double, swept_coefficients> model_coefficients(const Model& m)
-{
-    return {m.wall.e, m.wall.alpha, m.floor.e, m.floor.alpha, m.wall.mu, m.floor.mu, m.inertia};
-}
 
 std::vector<const Coordinate*> Job::range_axes() const
 {

@@ -54,16 +54,10 @@ std::vector<std::string> coefficient_names();
 // The model's own coefficients, one value each (what `Job::swept` and a result's attributes
 // hold): e_wall, alpha_wall, e_floor, alpha_floor, mu_wall, mu_floor, inertia.
 std::vector<std::string> model_coefficient_names();
-inline constexpr std::size_t swept_coefficients = 7;
-// A coefficient's value in its physical range (model.hpp), by its name ("e", "e_wall",
-// "alpha", "mu_floor", "inertia", ...), and the range as text for messages.
-bool coefficient_in_range(std::string_view name, double value);
-const char* coefficient_range_text(std::string_view name);
+inline constexpr std::size_t swept_coefficients = model_coefficient_count;  // core/model.hpp's model_coefficients()
 // SPEC.md 1b's coefficients (mu, mu_wall, mu_floor, inertia): results hold them only where
 // they are not their defaults, and files written before them have none.
 bool is_friction_coefficient(std::string_view name);
-// The values of model_coefficient_names() in `m`, in that order.
-std::array<double, swept_coefficients> model_coefficients(const Model& m);
 
 struct Job {
     Model model{};  // swept coefficients hold their range's min here (see model_at)

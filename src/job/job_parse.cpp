@@ -35,8 +35,11 @@ constexpr std::int64_t max_tile_points = std::int64_t{1} << 24;
 constexpr std::int64_t max_max_bounces = std::numeric_limits<std::uint32_t>::max();
 
 const std::vector<std::string> top_level_keys = {"model", "grid", "run"};
-const std::vector<std::string> model_keys = {"e",  "alpha",   "e_wall",   "alpha_wall", "e_floor", "alpha_floor",
-                                             "mu", "mu_wall", "mu_floor", "inertia",    "g",       "radius"};
+const std::vector<std::string> model_keys = [] {
+    std::vector<std::string> keys = coefficient_names();
+    keys.insert(keys.end(), {"g", "radius"});
+    return keys;
+}();
 const std::vector<std::string> range_keys = {"min", "max", "n"};
 const std::vector<std::string> run_keys = {"max_bounces", "output",      "tile_points", "refine",
                                            "compression", "alignment", "checkpoint_seconds", "writers"};

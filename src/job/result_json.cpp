@@ -13,12 +13,11 @@ nlohmann::ordered_json model_json(const Model& m)
 {
     nlohmann::ordered_json out = {
         {"e_wall", m.wall.e}, {"alpha_wall", m.wall.alpha}, {"e_floor", m.floor.e}, {"alpha_floor", m.floor.alpha}};
-    const Model defaults{};
-    if (m.wall.mu != defaults.wall.mu || m.floor.mu != defaults.floor.mu) {
+    if (m.frictional()) {
         out["mu_wall"] = std::isfinite(m.wall.mu) ? nlohmann::ordered_json(m.wall.mu) : nlohmann::ordered_json("inf");
         out["mu_floor"] = std::isfinite(m.floor.mu) ? nlohmann::ordered_json(m.floor.mu) : nlohmann::ordered_json("inf");
     }
-    if (m.inertia != defaults.inertia) out["inertia"] = m.inertia;
+    if (m.inertia != solid_ball_inertia) out["inertia"] = m.inertia;
     return out;
 }
 

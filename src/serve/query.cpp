@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/input.hpp"
+#include "job/job.hpp"
 #include "job/spelling.hpp"
 
 namespace superball::serve {
@@ -126,8 +127,7 @@ std::optional<std::string> Query::choice(std::string_view key, const std::vector
 
 std::vector<std::string> model_keys()
 {
-    std::vector<std::string> k;
-    for (const ModelKey& key : model_input_keys) k.emplace_back(key.name);
+    std::vector<std::string> k = coefficient_names();
     k.emplace_back("max_bounces");
     return k;
 }

@@ -574,6 +574,12 @@ TEST(EventCurve, RefusesWhatIsNoCurve)
     EXPECT_TRUE(independent(Parameter::e_wall, Parameter::e_floor));
     EXPECT_FALSE(independent(Parameter::e, Parameter::e_floor));
     EXPECT_FALSE(independent(Parameter::alpha, Parameter::alpha));
+    // SPEC.md 1b's: mu moves both surfaces' mu, inertia the ball's.
+    EXPECT_FALSE(independent(Parameter::mu, Parameter::mu_wall));
+    EXPECT_TRUE(independent(Parameter::mu_wall, Parameter::mu_floor));
+    EXPECT_TRUE(independent(Parameter::mu, Parameter::e));
+    EXPECT_TRUE(independent(Parameter::inertia, Parameter::alpha));
+    EXPECT_FALSE(independent(Parameter::inertia, Parameter::inertia));
 }
 
 }  // namespace
