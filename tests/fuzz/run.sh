@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the two libFuzzer targets with clang (AddressSanitizer + UndefinedBehaviorSanitizer,
-# every report fatal) and fuzzes each for half the time given, from its seed corpus:
+# every report fatal) and fuzzes each for half the time given, from its seed corpus (side by
+# side on two cores or more, so in half the time; one after the other on one):
 #
 #   fuzz_job     the job-file parser and validator (seeds: tests/fuzz/corpus and every job
 #                file in jobs/)
@@ -119,9 +120,26 @@ if ((seconds == 0)); then
   exec "$out/fuzz_result" -runs=0 "$out/result_corpus"
 fi
 half=$(((seconds + 1) / 2))
-echo "fuzz: fuzzing parse_job for ${half} s" >&2
-"$out/fuzz_job" "$out/corpus" -dict="$root/tests/fuzz/toml.dict" -max_total_time="$half" -max_len=8192 \
-  -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" -close_fd_mask=1
-echo "fuzz: fuzzing ResultReader for $((seconds - half)) s" >&2
-exec "$out/fuzz_result" "$out/result_corpus" -max_total_time="$((seconds - half))" -max_len=128 -len_control=0 \
-  -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" -close_fd_mask=1
+fuzz_job() {
+  echo "fuzz: fuzzing parse_job for ${half} s" >&2
+  "$out/fuzz_job" "$out/corpus" -dict="$root/tests/fuzz/toml.dict" -max_total_time="$half" -max_len=8192 \
+    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" -close_fd_mask=1
+}
+fuzz_result() {
+  echo "fuzz: fuzzing ResultReader for $((seconds - half)) s" >&2
+  "$out/fuzz_result" "$out/result_corpus" -max_total_time="$((seconds - half))" -max_len=128 -len_control=0 \
+    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$out/" -close_fd_mask=1
+}
+if (($(nproc) < 2)); then
+  fuzz_job
+  fuzz_result
+  exit
+fi
+# Side by side, each into a log of its own, printed whole once both have ended.
+fuzz_job >"$out/fuzz_job.log" 2>&1 &
+job=$!
+status=0
+fuzz_result >"$out/fuzz_result.log" 2>&1 || status=1
+wait "$job" || status=1
+cat "$out/fuzz_job.log" "$out/fuzz_result.log" >&2
+exit $status

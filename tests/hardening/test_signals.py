@@ -41,6 +41,12 @@ from superball_testing import (capped_job, descendants, killable_job, mpi_env, r
 
 MPIEXEC = os.environ.get("MPIEXEC") or "mpirun"
 
+
+def signal_env():
+    """mpi_env() with Open MPI's own second between the SIGTERM and the SIGKILL with which
+    mpirun ends the ranks (ctest sets it to 0 for the other tests: tests/CMakeLists.txt)."""
+    return {**mpi_env(), "OMPI_MCA_odls_base_sigkill_timeout": "1"}
+
 # The jobs' max_bounces are set from the speed of the binary under test
 # (wall_impacts_per_second), so that the runs last the same few seconds in a release build
 # and under AddressSanitizer: MEDIUM (killable_job) about 4 s on two ranks; LONG
@@ -85,7 +91,7 @@ class Signals(unittest.TestCase):
 
     def explore(self, job, output, *extra, expect=0):
         cmd = [MPIEXEC, "-n", "2", "--oversubscribe", self.binary, "explore", job, "-o", output, "-q", *extra]
-        r = subprocess.run(cmd, capture_output=True, text=True, env=mpi_env(), timeout=600)
+        r = subprocess.run(cmd, capture_output=True, text=True, env=signal_env(), timeout=600)
         self.assertEqual(r.returncode, expect, f"{' '.join(cmd)}\n{r.stderr}")
         return r
 
@@ -103,7 +109,7 @@ class Signals(unittest.TestCase):
         self.stderr_path = output + ".stderr"
         stderr = open(self.stderr_path, "w")
         cmd = [MPIEXEC, "-n", "2", "--oversubscribe", self.binary, "explore", job, "-o", output, "-q"]
-        proc = subprocess.Popen(cmd, env=mpi_env(), start_new_session=True, stdout=subprocess.DEVNULL, stderr=stderr)
+        proc = subprocess.Popen(cmd, env=signal_env(), start_new_session=True, stdout=subprocess.DEVNULL, stderr=stderr)
         stderr.close()
         return proc
 
