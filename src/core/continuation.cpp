@@ -42,6 +42,10 @@ constexpr int location_corrector_iterations = 60;
 // A located event is confirmed by an eigenvalue of D(G^k) this close to 1, -1 or the unit
 // circle.
 constexpr double confirmation_tolerance = 1e-6;
+// A grip-slide switch (a kink of the branch) counts as located where its test function is
+// this small: a jump of the corrector to another solution brackets a discontinuity instead,
+// where the test stays large.
+constexpr double switch_tolerance = 1e-7;
 
 // Which coefficient of a surface a parameter sets.
 enum class Kind : std::uint8_t { e, alpha, mu, inertia };
@@ -506,6 +510,28 @@ std::optional<std::pair<BranchEvent, std::string>> classify_event(const Test& te
     return std::nullopt;
 }
 
+// SPEC.md 1b: where an impact of the cycle passes from gripping to sliding, G^k is
+// continuous but its Jacobian jumps, and so does the branch's tangent. A turn beyond the
+// step guard's (a gripping cycle does not depend on mu: its branch runs straight along mu,
+// and turns at the switch toward the sliding cycles') is refused at every step size. The
+// step's end b is on the far side when a grip test changes sign between a and b: the
+// switching point between them, located, is where the branch goes on, along b's tangent.
+// nullopt when no grip test changes sign or the location finds no zero.
+std::optional<Position> switching_point(const Context& c, const Node& a, double h, const std::vector<double>& va,
+                                        const Node& b, const std::vector<double>& vb)
+{
+    for (std::size_t j = 0; j < c.tests.size(); ++j) {
+        const TestKind kind = c.tests[j].kind;
+        if (kind != TestKind::wall_grip && kind != TestKind::floor_grip) continue;
+        if (significant_sign(c.tests[j], va[j]) * significant_sign(c.tests[j], vb[j]) >= 0) continue;
+        Position where = locate(c, j, a, h, va[j], b, vb[j]);
+        if (std::abs(test_value(c.sys, c.tests[j], where.node, c.set)) > switch_tolerance) continue;
+        where.node.t = b.t;
+        return where;
+    }
+    return std::nullopt;
+}
+
 struct Direction {
     std::vector<Node> nodes;        // nodes[0] is the start
     std::vector<double> arclength;  // of each node, from the start
@@ -600,7 +626,13 @@ Direction trace(const Context& c, const Node& start)
         // Guards against jumping to another branch: the tangent turns little and the
         // corrector stays near the predictor.
         const bool ok = b && b->t.dot(a.t) >= min_tangent_cosine && (b->y - (a.y + h * a.t)).norm() <= h;
-        if (!ok) {
+        std::optional<Position> kink;
+        if (!ok && b) kink = switching_point(c, a, h, values.back(), *b, test_values(c.sys, c.tests, *b, c.set));
+        // The step taken: to the switch, where it leaves along the far side's tangent.
+        const double taken = kink ? kink->h : h;
+        if (kink) {
+            b = std::move(kink->node);
+        } else if (!ok) {
             h *= 0.5;
             if (h < c.set.min_step) {
                 d.end = BranchEvent::end;
@@ -613,8 +645,8 @@ Direction trace(const Context& c, const Node& start)
         const std::vector<double>& va = values.back();
         const std::size_t ia = d.nodes.size() - 1;
 
-        const std::optional<Located> stop = first_exit(c, a, *b, h, va, vb, ia);
-        std::vector<Located> found = sign_changes(c, d, values, last, *b, h, vb);
+        const std::optional<Located> stop = first_exit(c, a, *b, taken, va, vb, ia);
+        std::vector<Located> found = sign_changes(c, d, values, last, *b, taken, vb);
         for (Located& e : found) {
             if (stop && e.after == stop->after && e.h >= stop->h) continue;
             d.events.push_back(std::move(e));
@@ -626,11 +658,11 @@ Direction trace(const Context& c, const Node& start)
             return d;
         }
 
-        const double s = d.arclength.back() + h;
+        const double s = d.arclength.back() + taken;
         // Back at the start (a closed branch): stop, the loop is complete.
         const Vector4 to_start = d.nodes.front().y;
         const bool passed_start = d.nodes.size() > 3 && (to_start - a.y).dot(a.t) > 0.0 &&
-                                  (to_start - b->y).dot(b->t) <= 0.0 && (to_start - b->y).norm() < h;
+                                  (to_start - b->y).dot(b->t) <= 0.0 && (to_start - b->y).norm() < taken;
         const int iterations = b->iterations;
         d.nodes.push_back(std::move(*b));
         d.arclength.push_back(s);

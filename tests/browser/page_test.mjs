@@ -253,6 +253,34 @@ try {
   report.job = await page.$eval("#job-text", (e) => e.value);
   report.message = await page.$eval("#message", (e) => e.textContent);
 
+  // SPEC.md 1b from the panel: a finite mu and another ball; the readout at the probe counts
+  // with them (the tiles are requested again), and the exported job carries them.
+  const setField = (id, value) => page.$eval("#" + id, (e, v) => {
+    e.value = v;
+    e.dispatchEvent(new Event("change"));
+  }, value);
+  await setField("mu", "0.3");
+  await setField("inertia", "0.5");
+  await page.waitForFunction(() => window.explorer.state.mu === 0.3 && window.explorer.state.inertia === 0.5);
+  await settled();
+  await page.evaluate(() => { document.getElementById("readout").textContent = ""; });
+  await readoutAt(mapBox.x + p.x, mapBox.y + p.y);
+  report.friction = {
+    readout: await page.$eval("#readout", (e) => e.textContent),
+    start: await page.evaluate(() => window.explorer.readoutStart),
+    tiles: await page.evaluate(() => [...document.querySelectorAll(".leaflet-tile-container img")].filter(
+      (i) => i.src.includes("mu=0.3") && i.src.includes("inertia=0.5")).length),
+    url: await page.evaluate(() => location.hash),
+  };
+  await page.click("#export");
+  await page.waitForFunction(() => /^mu = /m.test(document.getElementById("job-text").value));
+  report.friction.job = await page.$eval("#job-text", (e) => e.value);
+  // An inf in the field gives the Cross model back (no mu sent).
+  await setField("mu", "inf");
+  await page.waitForFunction(() => window.explorer.state.mu === Infinity);
+  report.friction.reset_message = await page.$eval("#message", (e) => e.textContent);
+  await setField("inertia", "0.4");
+
   // The screenshot: the map, and the panel from its top (readout, trajectory, view).
   await page.$eval("#panel", (e) => { e.scrollTop = 0; });
   await readoutAt(mapBox.x + p.x, mapBox.y + p.y);

@@ -117,6 +117,24 @@ class BrowserTest(unittest.TestCase):
         self.assertAlmostEqual(float(xi.group(1)), report["visible"]["sw"]["x"], places=12)
         self.assertAlmostEqual(float(xi.group(2)), report["visible"]["ne"]["x"], places=12)
 
+        # SPEC.md 1b from the panel: mu = 0.3 and inertia = 0.5 reach the tiles, the readout
+        # (its count that of `superball count` with them) and the exported job.
+        friction = report["friction"]
+        self.assertGreater(friction["tiles"], 0, "no tile requested with the new model")
+        expected = count(friction["start"], *model, "--mu", "0.3", "--inertia", "0.5")
+        self.assertIn(f"N  = {expected['wall_bounces']} wall bounce", friction["readout"])
+        self.assertTrue(friction["readout"].rstrip().endswith(expected["outcome"]), friction["readout"])
+        self.assertRegex(friction["job"], r"(?m)^mu = 0\.3$")
+        self.assertRegex(friction["job"], r"(?m)^inertia = 0\.5$")
+        self.assertIn("&mu=0.3&", friction["url"])  # the bookmarkable view holds the model
+        self.assertEqual(friction["reset_message"], "")
+        with tempfile.TemporaryDirectory() as tmp:
+            job = os.path.join(tmp, "view.toml")
+            with open(job, "w") as f:
+                f.write(friction["job"])
+            r = subprocess.run([BINARY, "explore", job, "--dry-run"], capture_output=True, text=True, timeout=60)
+            self.assertEqual(r.returncode, 0, r.stderr)
+
         with open(screenshot, "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
 

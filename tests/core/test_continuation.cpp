@@ -438,6 +438,70 @@ TEST(Continuation, PeriodDoublingIsARealEigenvalueThroughMinusOne)
     }
 }
 
+// ---- Grip and slide (SPEC.md 1b) -----------------------------------------------------------
+
+// The friction coefficient at which an impact of the Cross model's cycle `c` begins to
+// slide, from SPEC.md 1b's formulas written out here: psi (1 + alpha) / ((1 + e)(1 + 1/kappa))
+// with psi = |s| / v_n of its wall impact (canonical coordinates: u = U, v = 1 - 2 xi) and of
+// the floor impact after it (reached with vertical speed sqrt(v+^2 + 2 y), y = 2 xi (1 - xi)
+// the height of the wall impact, where v0 = g = 1).
+struct SwitchingMu {
+    double wall = 0.0, floor = 0.0;
+};
+
+SwitchingMu switching_mu(const CanonicalState<double>& c, const Model& model)
+{
+    const double kappa = model.inertia;
+    const auto limit = [&](const Surface& f, double psi) { return psi * (1.0 + f.alpha) / ((1.0 + f.e) * (1.0 + 1.0 / kappa)); };
+    const double u = c.U, v = 1.0 - 2.0 * c.xi, W = c.W;
+    const double beta = model.wall.alpha;
+    const double v_after = ((1.0 - kappa * beta) * v + kappa * (1.0 + beta) * W) / (1.0 + kappa);
+    const double W_after = ((1.0 + beta) * v + (kappa - beta) * W) / (1.0 + kappa);
+    const double u_after = -model.wall.e * u;
+    const double floor_speed = std::sqrt(v_after * v_after + 4.0 * c.xi * (1.0 - c.xi));
+    return {limit(model.wall, std::abs(v - W) / -u), limit(model.floor, std::abs(u_after + W_after) / floor_speed)};
+}
+
+// Continued down in mu from 5, the interior fixed point of e = 0.9, alpha = 0.99 grips until
+// mu reaches what its wall impact needs (its floor impact needs less): the cycle stays the
+// Cross model's, with no event, then the branch turns (a kink: G is continuous, its Jacobian
+// jumps) and goes on through sliding cycles. The switch is located to 1e-8 of the reference.
+TEST(Continuation, GripSlideWhereTheGrippingCycleNeedsMoreThanMu)
+{
+    Model model = dissipative;
+    model.wall.mu = model.floor.mu = 5.0;
+    const CanonicalState<double> cross = cycle_at(interior_start, dissipative, 1).points.front();
+    const SwitchingMu needed = switching_mu(cross, dissipative);
+    ASSERT_GT(needed.wall, needed.floor);
+    ASSERT_LT(needed.wall, 5.0);
+
+    const Branch b = branch_of(interior_start, model, Parameter::mu, 1, 0.05, 5.0);
+    expect_points_are_cycles(b, model, Parameter::mu, 0.05, 5.0);
+    expect_points_are_newton_cycles(b, model, Parameter::mu, 2);
+    const auto slides = events_of(b, BranchEvent::grip_slide);
+    ASSERT_FALSE(slides.empty());
+    const BranchPoint& first = *std::max_element(slides.begin(), slides.end(), [](const auto& x, const auto& y) {
+        return x.parameter < y.parameter;
+    });
+    EXPECT_NEAR(first.parameter, needed.wall, 1e-8);
+    EXPECT_LE(first.bracket, 1e-8);
+    EXPECT_NE(first.note.find("wall impact"), std::string::npos) << first.note;
+    std::size_t beyond = 0;
+    for (const BranchPoint& q : b.points) {
+        SCOPED_TRACE(testing::Message() << "mu = " << q.parameter << ", " << name(q.event));
+        if (q.parameter > needed.wall + 1e-8) {
+            // Gripping: the Cross model's cycle, and no event but the end at mu = 5.
+            EXPECT_LE((as_vector(q.point) - as_vector(cross)).norm(), 1e-9);
+            EXPECT_TRUE(q.event == BranchEvent::none || (q.event == BranchEvent::end && q.parameter == 5.0));
+        } else if (q.parameter < needed.wall - 1e-6) {
+            ++beyond;
+        }
+    }
+    // The branch went on past the switch, not stopped by a corrector that could not turn.
+    EXPECT_GE(beyond, 3u);
+    EXPECT_NE(b.points.front().note.find("xi -> 0"), std::string::npos) << b.points.front().note;
+}
+
 // ---- Event curves in (alpha, e) ----------------------------------------------------------
 
 EventCurve curve_of(const Branch& b, BranchEvent e, std::size_t nth, double min_e, double max_e)

@@ -18,6 +18,7 @@
   const COUNT_DELAY_MS = 40;
   const TRAJECTORY_SAMPLES = 24;
   const ANIMATION_SECONDS = 6;
+  const SOLID_BALL_INERTIA = 0.4;
 
   const $ = (id) => document.getElementById(id);
 
@@ -25,11 +26,15 @@
   const state = {
     layer: "", x: "xi", y: "W", fixed: -1, x_min: 0, x_max: 1, y_min: -3, y_max: 3,
     per_surface: false, e: 0.9, alpha: 0.9, e_wall: 0.9, alpha_wall: 0.9, e_floor: 0.9, alpha_floor: 0.9,
+    mu: Infinity, mu_wall: Infinity, mu_floor: Infinity, inertia: SOLID_BALL_INERTIA,
     max_bounces: 1000, show: "count", colours: "turbo", colour_max: 20,
   };
   const NUMBERS = ["fixed", "x_min", "x_max", "y_min", "y_max", "e", "alpha", "e_wall", "alpha_wall", "e_floor",
-                   "alpha_floor", "max_bounces", "colour_max"];
-  const SURFACE_KEYS = ["e_wall", "alpha_wall", "e_floor", "alpha_floor"];
+                   "alpha_floor", "mu", "mu_wall", "mu_floor", "inertia", "max_bounces", "colour_max"];
+  const SURFACE_KEYS = ["e_wall", "alpha_wall", "mu_wall", "e_floor", "alpha_floor", "mu_floor"];
+  // SPEC.md 1b: a friction coefficient is infinite (the Cross model: no sliding) unless given;
+  // its field shows and takes "inf" for that.
+  const FRICTION = ["mu", "mu_wall", "mu_floor"];
 
   let info = null;   // /api/info
   let map = null;
@@ -46,9 +51,12 @@
 
   // --- The view as API parameters -----------------------------------------------------
 
+  // Only what differs from SPEC.md 1b's defaults is sent: the server then computes (and a
+  // view exports) the model of section 1 as before.
   function modelParams(p) {
-    const keys = state.per_surface ? SURFACE_KEYS : ["e", "alpha"];
-    for (const k of keys) p.set(k, String(state[k]));
+    const keys = state.per_surface ? SURFACE_KEYS : ["e", "alpha", "mu"];
+    for (const k of keys) if (!(FRICTION.includes(k) && state[k] === Infinity)) p.set(k, String(state[k]));
+    if (state.inertia !== SOLID_BALL_INERTIA) p.set("inertia", String(state.inertia));
     p.set("max_bounces", String(state.max_bounces));
     return p;
   }
@@ -138,7 +146,9 @@
     $("per-surface").checked = state.per_surface;
     $("one-material").hidden = state.per_surface;
     $("two-materials").hidden = !state.per_surface;
-    for (const k of ["e", "alpha"].concat(SURFACE_KEYS)) $(k).value = state[k];
+    for (const k of ["e", "alpha", "mu", "inertia"].concat(SURFACE_KEYS)) {
+      $(k).value = state[k] === Infinity ? "inf" : state[k];
+    }
     $("max-bounces").value = state.max_bounces;
     $("show").value = state.show;
     $("colours").value = state.colours;
@@ -154,12 +164,13 @@
     next.colours = $("colours").value;
     const fields = { fixed: "fixed", x_min: "x-min", x_max: "x-max", y_min: "y-min", y_max: "y-max",
                      e: "e", alpha: "alpha", e_wall: "e_wall", alpha_wall: "alpha_wall", e_floor: "e_floor",
-                     alpha_floor: "alpha_floor", max_bounces: "max-bounces", colour_max: "colour-max" };
+                     alpha_floor: "alpha_floor", mu: "mu", mu_wall: "mu_wall", mu_floor: "mu_floor", inertia: "inertia",
+                     max_bounces: "max-bounces", colour_max: "colour-max" };
     for (const [key, id] of Object.entries(fields)) {
       const text = $(id).value.trim();
-      const v = Number(text);
-      if (text === "" || !Number.isFinite(v)) {
-        say(key + " = " + JSON.stringify(text) + " is not a number");
+      const v = readNumber(key, text);
+      if (v === null) {
+        say(key + " = " + JSON.stringify(text) + " is not a number" + (FRICTION.includes(key) ? " (or inf)" : ""));
         return null;
       }
       next[key] = v;
@@ -169,6 +180,14 @@
       return null;
     }
     return next;
+  }
+
+  // A finite number, or for a friction coefficient also inf (empty, "inf", "infinity"); null
+  // otherwise. The server checks the ranges and names what it refuses.
+  function readNumber(key, text) {
+    if (FRICTION.includes(key) && /^(|\+?inf(inity)?|\u221e)$/i.test(text)) return Infinity;
+    const v = Number(text);
+    return text !== "" && Number.isFinite(v) ? v : null;
   }
 
   function saveToUrl() {
@@ -182,8 +201,8 @@
     for (const [k, v] of p.entries()) {
       if (!(k in state)) continue;
       if (NUMBERS.includes(k)) {
-        const n = Number(v);
-        if (Number.isFinite(n)) state[k] = n;
+        const n = readNumber(k, v);
+        if (n !== null) state[k] = n;
       } else if (k === "per_surface") {
         state[k] = v === "true";
       } else {
@@ -251,9 +270,12 @@
       state.fixed = l.view.value;
       [state.x_min, state.x_max] = [l.grid[state.x].min, l.grid[state.x].max];
       [state.y_min, state.y_max] = [l.grid[state.y].min, l.grid[state.y].max];
-      const m = l.model;
-      state.per_surface = !(m.e_wall === m.e_floor && m.alpha_wall === m.alpha_floor);
-      Object.assign(state, m, { e: m.e_wall, alpha: m.alpha_wall });
+      // The layer's model as /api/info gives it: SPEC.md 1b's coefficients only where not
+      // their defaults, an infinite mu as "inf" (JSON has no infinity).
+      const m = Object.assign({ mu_wall: "inf", mu_floor: "inf", inertia: SOLID_BALL_INERTIA }, l.model);
+      for (const k of ["mu_wall", "mu_floor"]) m[k] = m[k] === "inf" ? Infinity : Number(m[k]);
+      state.per_surface = !(m.e_wall === m.e_floor && m.alpha_wall === m.alpha_floor && m.mu_wall === m.mu_floor);
+      Object.assign(state, m, { e: m.e_wall, alpha: m.alpha_wall, mu: m.mu_wall });
       state.max_bounces = l.max_bounces;
     }
     refresh(true);
@@ -360,10 +382,13 @@
     g.append(svg("rect", { class: "surface", x: -pad, y: -pad, width: xmax + 2 * pad, height: pad }));
     g.append(svg("polyline", { class: "path", points: path.map((q) => q.x + "," + q.y).join(" "),
                                "vector-effect": "non-scaling-stroke" }));
+    // A wall impact that slid (SPEC.md 1b: its grip exceeded mu) is drawn filled.
     for (const e of tr.events) {
-      if (e.event === "wall") g.append(svg("circle", { class: "impact", cx: e.x, cy: e.y, r: 0.02 * extent,
+      if (e.event === "wall") g.append(svg("circle", { class: e.contact === "slide" ? "impact slide" : "impact",
+                                                         cx: e.x, cy: e.y, r: 0.02 * extent,
                                                          "vector-effect": "non-scaling-stroke" }));
     }
+    const slid = tr.events.filter((e) => e.contact === "slide").length;
     const ball = svg("circle", { class: "ball", cx: path[0].x, cy: path[0].y, r: 0.025 * extent });
     g.append(ball);
     root.append(g);
@@ -371,7 +396,8 @@
     $("trajectory-info").textContent =
       "start xi = " + f(s.xi) + ", U = " + f(s.U) + ", W = " + f(s.W) + "\n" + tr.wall_bounces + " wall bounce" +
       (tr.wall_bounces === 1 ? "" : "s") + ", " + tr.outcome + "; " + tr.events.length + " events" +
-      (tr.events_truncated ? " (the rest below double precision)" : "");
+      (tr.events_truncated ? " (the rest below double precision)" : "") +
+      (slid ? "\n" + slid + " of the impacts slid" : "");
     // The ball follows the samples in time, the whole motion in ANIMATION_SECONDS.
     const t0 = path[0].t, t1 = path[path.length - 1].t || 1;
     const begin = performance.now();
@@ -461,8 +487,9 @@
     map.on("click", onClick);
     map.on("zoomend", () => { if (map.getZoom() >= REBASE_ZOOM) rebase(); });
 
-    for (const id of ["fixed", "x-min", "x-max", "y-min", "y-max", "e", "alpha", "e_wall", "alpha_wall", "e_floor",
-                      "alpha_floor", "max-bounces", "colour-max", "show", "colours", "per-surface"]) {
+    for (const id of ["fixed", "x-min", "x-max", "y-min", "y-max", "e", "alpha", "mu", "e_wall", "alpha_wall", "mu_wall",
+                      "e_floor", "alpha_floor", "mu_floor", "inertia", "max-bounces", "colour-max", "show", "colours",
+                      "per-surface"]) {
       $(id).addEventListener("change", onControlChange);
     }
     $("x-axis").addEventListener("change", () => onAxisChange("x"));
