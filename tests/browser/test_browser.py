@@ -44,6 +44,15 @@ def count(start, *model):
 
 
 class BrowserTest(unittest.TestCase):
+    def assert_explore_accepts(self, job_text):
+        """`superball explore --dry-run` accepts the exported job."""
+        with tempfile.TemporaryDirectory() as tmp:
+            job = os.path.join(tmp, "view.toml")
+            with open(job, "w") as f:
+                f.write(job_text)
+            r = subprocess.run([BINARY, "explore", job, "--dry-run"], capture_output=True, text=True, timeout=60)
+            self.assertEqual(r.returncode, 0, r.stderr)
+
     def test_page(self):
         node = shutil.which("node")
         self.assertIsNotNone(node, "node is needed: .ci/install-deps --browser")
@@ -106,12 +115,7 @@ class BrowserTest(unittest.TestCase):
 
         # The exported job: the visible part of the map, accepted by explore.
         self.assertIn("[grid]", report["job"])
-        with tempfile.TemporaryDirectory() as tmp:
-            job = os.path.join(tmp, "view.toml")
-            with open(job, "w") as f:
-                f.write(report["job"])
-            r = subprocess.run([BINARY, "explore", job, "--dry-run"], capture_output=True, text=True, timeout=60)
-            self.assertEqual(r.returncode, 0, r.stderr)
+        self.assert_explore_accepts(report["job"])
         xi = re.search(r"^xi = \{ min = (\S+), max = (\S+), n = 4096 \}$", report["job"], re.M)
         self.assertIsNotNone(xi, report["job"])
         self.assertAlmostEqual(float(xi.group(1)), report["visible"]["sw"]["x"], places=12)
@@ -128,12 +132,7 @@ class BrowserTest(unittest.TestCase):
         self.assertRegex(friction["job"], r"(?m)^inertia = 0\.5$")
         self.assertIn("&mu=0.3&", friction["url"])  # the bookmarkable view holds the model
         self.assertEqual(friction["reset_message"], "")
-        with tempfile.TemporaryDirectory() as tmp:
-            job = os.path.join(tmp, "view.toml")
-            with open(job, "w") as f:
-                f.write(friction["job"])
-            r = subprocess.run([BINARY, "explore", job, "--dry-run"], capture_output=True, text=True, timeout=60)
-            self.assertEqual(r.returncode, 0, r.stderr)
+        self.assert_explore_accepts(friction["job"])
 
         with open(screenshot, "rb") as f:
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")

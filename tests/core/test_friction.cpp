@@ -6,6 +6,7 @@
 // variant counts as the scalar kernel does.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "core/count.hpp"
+#include "core/dynamics.hpp"
 #include "core/impact.hpp"
 #include "core/kernels.hpp"
 #include "core/map.hpp"
@@ -410,6 +412,66 @@ TEST(FrictionKernels, FiniteMuChangesTheSliceInfiniteDoesNot)
     std::size_t differ = 0;
     for (std::size_t p = 0; p < a.size(); ++p) differ += a[p] != b[p];
     EXPECT_GT(differ, a.size() / 20);
+}
+
+// ------------------------------------------------------------------ cycles
+
+// Fixed points of the piecewise smooth map take the Jacobian of the side of each switching
+// surface they lie on. At e = 0.9, alpha = 0.99, mu = 0.5 (`superball fixed-points --e 0.9
+// --alpha 0.99 --mu 0.5`) the fixed point's wall impact slides (SPEC.md 1b's threshold,
+// written out here), and the eigenvalues make_cycle reports (automatic differentiation) are
+// those of a central-difference Jacobian of G there: every difference stays on the point's
+// side of both impacts' switches.
+TEST(FrictionCycles, FixedPointOfASlidingImpactHasItsSidesJacobian)
+{
+    Model model = Model::uniform(0.9, 0.99);
+    model.wall.mu = model.floor.mu = 0.5;
+    const ModelMatrices m = ModelMatrices::of(model);
+    const auto point = newton_cycle({0.673, -0.514, 23.78}, m, 1);
+    ASSERT_TRUE(point.has_value());
+    const auto cycle = make_cycle(*point, m, 1);
+    ASSERT_TRUE(cycle.has_value());
+    const CanonicalState<double> s = cycle->points.front();
+    EXPECT_LE(cycle->residual, 1e-12);
+
+    // SPEC.md 1b: grips while psi <= mu (1 + e)(1 + 1/kappa) / (1 + alpha); u = U, v = 1 - 2 xi.
+    const double psi = std::abs(1.0 - 2.0 * s.xi - s.W) / -s.U;
+    EXPECT_GT(psi, 1.5 * 0.5 * 1.9 * 3.5 / 1.99) << "the wall impact slides, well past its switch";
+
+    const auto sides = [&](const CanonicalState<double>& c) {
+        const ImpactContacts ic = impact_contacts(c, m);
+        return std::pair{std::abs(ic.s_wall) > m.wall.grip_ratio * ic.approach_wall,
+                         std::abs(ic.s_floor) > m.floor.grip_ratio * ic.approach_floor};
+    };
+    // Central differences of G with the matrices `with` (they stay on s's side of the switches).
+    const auto eigenvalues_of_differences = [&](const ModelMatrices& with) {
+        Eigen::Matrix3d differences;
+        for (int j = 0; j < 3; ++j) {
+            const double h = 1e-6 * std::max(1.0, std::abs(as_vector(s)(j)));
+            Eigen::Vector3d up = as_vector(s), down = as_vector(s);
+            up(j) += h;
+            down(j) -= h;
+            EXPECT_EQ(sides(as_state(up)), sides(s));
+            EXPECT_EQ(sides(as_state(down)), sides(s));
+            differences.col(j) = (as_vector(canonical_map(as_state(up), with).next) -
+                                  as_vector(canonical_map(as_state(down), with).next)) / (2.0 * h);
+        }
+        return Eigen::Vector3cd(differences.eigenvalues());
+    };
+    // The largest distance from a reported eigenvalue to the nearest of `expected`, relative.
+    const auto distance = [&](const Eigen::Vector3cd& expected) {
+        double worst = 0.0;
+        for (const std::complex<double>& z : cycle->eigenvalues) {
+            double nearest = inf;
+            for (int k = 0; k < 3; ++k) nearest = std::min(nearest, std::abs(expected(k) - z));
+            worst = std::max(worst, nearest / std::abs(z));
+        }
+        return worst;
+    };
+    EXPECT_LE(distance(eigenvalues_of_differences(m)), 1e-5);
+    // ... and not those of the gripping side's formulas (the Cross model's map at the same
+    // point): the test tells the sides apart.
+    EXPECT_GT(distance(eigenvalues_of_differences(ModelMatrices::of(Model::uniform(0.9, 0.99)))), 1e-2);
 }
 
 }  // namespace
