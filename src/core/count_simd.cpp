@@ -144,9 +144,10 @@ void settle(const Stepped& next, std::size_t n, const std::size_t* point, Live& 
 // overlap many batches; interleaved, every batch waited on its own divisions and square
 // root.
 // The two sweeps are flattened (every call in them inlined): with both impact laws
-// instantiated, GCC 12 left canonical_map, the impacts, their selects and `representable`
-// out of line in them, each call passing the batches through memory (the default model lost
-// 6-9 % of its speed on AVX2).
+// instantiated, GCC 12 left canonical_map, the impacts, the lane select detail::choose
+// (16 calls in the AVX2 object) and `representable` out of line in them, each call passing
+// the batches through memory (the default model lost 6-9 % of its speed on AVX2,
+// docs/speed.md).
 template <ImpactLaw law>
 [[gnu::flatten]] void first_sweep(const simd_variant::Arrays& in, std::size_t first, std::size_t n, const ModelMatrices& m,
                  double max_bounces, Stepped& next, Live& live, std::size_t* index)

@@ -25,12 +25,8 @@
 namespace superball {
 
 namespace detail {
-// cond ? a : b, lane by lane for SIMD batches. Both branches are computed. Always inlined:
-// with the friction law's uses beside the flight's, GCC 12 called the SIMD overload out of
-// line from the AVX2 kernel's loops (16 calls, the batches passed through memory), which
-// cost the default model 6-9 % of its speed there (docs/speed.md; the kernels'
-// sweeps are flattened too, count_simd.cpp).
-[[gnu::always_inline]] inline double choose(bool cond, double a, double b) { return cond ? a : b; }
+// cond ? a : b, lane by lane for SIMD batches. Both branches are computed.
+inline double choose(bool cond, double a, double b) { return cond ? a : b; }
 // Other scalar number types (automatic differentiation in dynamics.hpp).
 template <class T>
 T choose(bool cond, const T& a, const T& b)
@@ -38,9 +34,8 @@ T choose(bool cond, const T& a, const T& b)
     return cond ? a : b;
 }
 template <class T, class Abi>
-[[gnu::always_inline]] inline std::experimental::simd<T, Abi> choose(
-    const typename std::experimental::simd<T, Abi>::mask_type& cond, std::experimental::simd<T, Abi> a,
-    const std::experimental::simd<T, Abi>& b)
+std::experimental::simd<T, Abi> choose(const typename std::experimental::simd<T, Abi>::mask_type& cond,
+                                       std::experimental::simd<T, Abi> a, const std::experimental::simd<T, Abi>& b)
 {
     std::experimental::where(!cond, a) = b;
     return a;
@@ -48,7 +43,7 @@ template <class T, class Abi>
 // |x| found by argument-dependent lookup (SIMD batches, automatic differentiation).
 using std::abs;
 template <class T>
-[[gnu::always_inline]] inline T magnitude(const T& x)
+T magnitude(const T& x)
 {
     return T(abs(x));
 }
