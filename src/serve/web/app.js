@@ -29,8 +29,12 @@
     mu: Infinity, mu_wall: Infinity, mu_floor: Infinity, inertia: SOLID_BALL_INERTIA,
     max_bounces: 1000, show: "count", colours: "turbo", colour_max: 20,
   };
-  const NUMBERS = ["fixed", "x_min", "x_max", "y_min", "y_max", "e", "alpha", "e_wall", "alpha_wall", "e_floor",
-                   "alpha_floor", "mu", "mu_wall", "mu_floor", "inertia", "max_bounces", "colour_max"];
+  // The view's numbers and the ids of the fields that set them.
+  const NUMBER_FIELDS = { fixed: "fixed", x_min: "x-min", x_max: "x-max", y_min: "y-min", y_max: "y-max",
+                          e: "e", alpha: "alpha", e_wall: "e_wall", alpha_wall: "alpha_wall", e_floor: "e_floor",
+                          alpha_floor: "alpha_floor", mu: "mu", mu_wall: "mu_wall", mu_floor: "mu_floor",
+                          inertia: "inertia", max_bounces: "max-bounces", colour_max: "colour-max" };
+  const NUMBERS = Object.keys(NUMBER_FIELDS);
   const SURFACE_KEYS = ["e_wall", "alpha_wall", "mu_wall", "e_floor", "alpha_floor", "mu_floor"];
   // SPEC.md 1b: a friction coefficient is infinite (the Cross model: no sliding) unless given;
   // its field shows and takes "inf" for that.
@@ -162,11 +166,7 @@
     next.per_surface = $("per-surface").checked;
     next.show = $("show").value;
     next.colours = $("colours").value;
-    const fields = { fixed: "fixed", x_min: "x-min", x_max: "x-max", y_min: "y-min", y_max: "y-max",
-                     e: "e", alpha: "alpha", e_wall: "e_wall", alpha_wall: "alpha_wall", e_floor: "e_floor",
-                     alpha_floor: "alpha_floor", mu: "mu", mu_wall: "mu_wall", mu_floor: "mu_floor", inertia: "inertia",
-                     max_bounces: "max-bounces", colour_max: "colour-max" };
-    for (const [key, id] of Object.entries(fields)) {
+    for (const [key, id] of Object.entries(NUMBER_FIELDS)) {
       const text = $(id).value.trim();
       const v = readNumber(key, text);
       if (v === null) {
@@ -487,9 +487,7 @@
     map.on("click", onClick);
     map.on("zoomend", () => { if (map.getZoom() >= REBASE_ZOOM) rebase(); });
 
-    for (const id of ["fixed", "x-min", "x-max", "y-min", "y-max", "e", "alpha", "mu", "e_wall", "alpha_wall", "mu_wall",
-                      "e_floor", "alpha_floor", "mu_floor", "inertia", "max-bounces", "colour-max", "show", "colours",
-                      "per-surface"]) {
+    for (const id of Object.values(NUMBER_FIELDS).concat(["show", "colours", "per-surface"])) {
       $(id).addEventListener("change", onControlChange);
     }
     $("x-axis").addEventListener("change", () => onAxisChange("x"));
