@@ -128,6 +128,9 @@ struct ImpactContacts {
     double s_wall, approach_wall, s_floor, approach_floor;
 };
 
+// canonical_map's first half written again: shared through a struct of the three states (wall,
+// after the wall, floor arrival), the AVX2 kernel ran at 0.64 of its speed (its loops spilled
+// the batches; bench_kernel BM_count_slice/avx2/4096, 5 interleaved repetitions).
 inline ImpactContacts impact_contacts(const CanonicalState<double>& c, const ModelMatrices& m)
 {
     const double v_w = 1.0 - 2.0 * c.xi;
