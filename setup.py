@@ -11,9 +11,13 @@ the wheel. Environment:
     SUPERBALL_PIP_BUILD_DIR  the CMake build tree to use (default build/pip-<interpreter tag>:
                              kept, so that a second install rebuilds only what changed)
     SUPERBALL_PIP_JOBS       parallel compile jobs (default: the cores this process may use)
+    SUPERBALL_PIP_CMAKE_ARGS more CMake options, split as a shell would, after setup.py's own
+                             (which they override), e.g. "-DSUPERBALL_NATIVE=ON" for a module
+                             compiled for this processor only (docs/building.md)
 """
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -52,7 +56,8 @@ class CMakeBuild(build_ext):
             generator = ["-G", "Ninja"]
         # Only what the module needs: no tests, no benchmarks.
         subprocess.run([cmake, "-S", ROOT, "-B", build, *generator, "-DCMAKE_BUILD_TYPE=Release", f"-DPython_EXECUTABLE={sys.executable}",
-                        "-DSUPERBALL_PYTHON_MODULE=ON", "-DSUPERBALL_TESTS=OFF", "-DSUPERBALL_BENCHMARKS=OFF"], check=True)
+                        "-DSUPERBALL_PYTHON_MODULE=ON", "-DSUPERBALL_TESTS=OFF", "-DSUPERBALL_BENCHMARKS=OFF",
+                        *shlex.split(os.environ.get("SUPERBALL_PIP_CMAKE_ARGS", ""))], check=True)
         subprocess.run([cmake, "--build", build, "--target", "superball_python", "-j", jobs], check=True)
         built = os.path.join(build, "python", "superball", os.path.basename(self.get_ext_filename(ext.name)))
         if not os.path.exists(built):

@@ -31,6 +31,9 @@ inline Id type_id(hid_t id, std::string_view what) { return {id, H5Tclose, what}
 inline Id attribute_id(hid_t id, std::string_view what) { return {id, H5Aclose, what}; }
 inline Id object_id(hid_t id, std::string_view what) { return {id, H5Oclose, what}; }
 
+// A box's origin or extent (job/tiles.hpp's Extent, an entry per range axis) as HDF5's dimensions.
+inline std::vector<hsize_t> to_hsize(std::span<const std::uint64_t> e) { return {e.begin(), e.end()}; }
+
 // HDF5 prints its own error stack by default; the messages here say what failed.
 void silence_errors();
 

@@ -23,8 +23,6 @@ static_assert(std::endian::native == std::endian::little,
 
 namespace {
 
-std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
-
 // The data of a dataset, one chunk per tile. Uncompressed: every chunk allocated at
 // creation and never filled; with the HDF5 1.10 format, no filter and early allocation,
 // HDF5 indexes the chunks implicitly (chunk t lies at the dataset's first chunk plus t
@@ -34,8 +32,8 @@ std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
 // indexed where rank 0 appended them when the run completes.
 void create_tiled(hid_t file, const char* name, hid_t type, const Tiling& tiling, int level)
 {
-    h5::create_dataset(file, name, type, to_hsize(tiling.shape()),
-                       {to_hsize(tiling.tile_shape()), level, level > 0 ? H5D_ALLOC_TIME_INCR : H5D_ALLOC_TIME_EARLY,
+    h5::create_dataset(file, name, type, h5::to_hsize(tiling.shape()),
+                       {h5::to_hsize(tiling.tile_shape()), level, level > 0 ? H5D_ALLOC_TIME_INCR : H5D_ALLOC_TIME_EARLY,
                         H5D_FILL_TIME_NEVER});
 }
 
@@ -47,7 +45,7 @@ void create_journal(hid_t loc, const char* name, hid_t type, hsize_t n, hsize_t 
 }
 
 // Chunk `t`'s first element, as dataset coordinates.
-std::vector<hsize_t> chunk_origin(const Tiling& tiling, std::uint64_t t) { return to_hsize(tiling.box(t).start); }
+std::vector<hsize_t> chunk_origin(const Tiling& tiling, std::uint64_t t) { return h5::to_hsize(tiling.box(t).start); }
 
 PartialLayout layout_of(hid_t file, const Tiling& tiling)
 {

@@ -143,7 +143,7 @@ bool ResultReader::tile_intact(std::uint64_t t) const
         return tile_checksum(t, all.first(c.counts_bytes), all.subspan(c.counts_bytes)) == sums_[t];
     }
     // The chunks as stored, the bytes the checksum was taken of.
-    const std::vector<hsize_t> origin = to_hsize(tiling_->box(t).start);
+    const std::vector<hsize_t> origin = h5::to_hsize(tiling_->box(t).start);
     std::uint64_t chunk_points = 1;
     for (const std::uint64_t n : info_.tile_shape) chunk_points *= n;
     const std::optional<std::vector<std::byte>> counts = h5::read_raw_chunk(counts_.get(), origin, chunk_points * info_.count_bytes);
@@ -226,7 +226,7 @@ std::uint64_t ResultReader::read(const Box& box, std::span<std::uint32_t> counts
 std::uint64_t ResultReader::read_checked(const Box& box, std::span<std::uint32_t> counts,
                                          std::span<std::uint8_t> outcomes) const
 {
-    const std::vector<hsize_t> start = to_hsize(box.start), count = to_hsize(box.count);
+    const std::vector<hsize_t> start = h5::to_hsize(box.start), count = h5::to_hsize(box.count);
     if (compressed_) {
         read_stored(box, counts, outcomes);
     } else {

@@ -28,8 +28,6 @@ inline constexpr std::uint64_t max_points = std::uint64_t{1} << 40;
 inline constexpr std::size_t max_job_bytes = std::size_t{1} << 20;
 inline constexpr std::size_t max_text_bytes = 4096;
 
-inline std::vector<hsize_t> to_hsize(const Extent& e) { return {e.begin(), e.end()}; }
-
 // "a scalar", or the dimensions as "(40, 30)".
 std::string dims_text(const std::vector<hsize_t>& dims);
 // What an attribute or dataset holds, for messages: "a text", "a list of 2 integers", ...

@@ -2,7 +2,7 @@
 // boundary planes (core/boundary_planes.hpp).
 #include <gtest/gtest.h>
 
-#include <Eigen/Dense>
+#include <Eigen/LU>  // determinant()
 #include <algorithm>
 #include <array>
 #include <cmath>
