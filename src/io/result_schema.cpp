@@ -81,7 +81,7 @@ std::vector<std::pair<std::uint64_t, std::uint64_t>> raw_data_ranges(hid_t file)
             const h5::Id stored_set = h5::open_dataset(file, layout::tile_stored);
             const h5::Shape ds = h5::dataset_shape_of(done_set), ss = h5::dataset_shape_of(stored_set);
             if (ds.dims.size() == 1 && ds.bytes == 1 && ss.bytes == 8 && ss.dims == std::vector<hsize_t>{ds.dims[0], 3} &&
-                ds.dims[0] <= max_points) {
+                ds.dims[0] <= max_grid_points) {
                 // A window of tiles at a time, the ranges merged as they come (appended
                 // tiles lie one after the other): neither the journal nor a range a tile is
                 // held at once (41 bytes a tile, 170 MiB at 4 million tiles).
@@ -372,7 +372,7 @@ void ResultReader::validate_no_journal()
         if (h5::object_type(file_, layout::tile_done) == h5::ObjectType::dataset) {
             const h5::Id d = h5::open_dataset(file_, layout::tile_done);
             const h5::Shape s = h5::dataset_shape_of(d);
-            if (s.type == h5::TypeClass::integer && s.bytes == 1 && s.dims.size() == 1 && s.dims[0] <= max_points &&
+            if (s.type == h5::TypeClass::integer && s.bytes == 1 && s.dims.size() == 1 && s.dims[0] <= max_grid_points &&
                 h5::dataset_storage(d).allocated) {
                 std::vector<std::uint8_t> flags(s.dims[0]);
                 h5::read(d, std::span(flags), layout::tile_done);
@@ -423,7 +423,7 @@ void ResultReader::validate_data()
     std::uint64_t points = 1;
     for (const hsize_t n : cs.dims) {
         if (n == 0) check.fail("/wall_bounces " + dims_text(cs.dims) + " is empty");
-        if (__builtin_mul_overflow(points, n, &points) || points > max_points) {
+        if (__builtin_mul_overflow(points, n, &points) || points > max_grid_points) {
             check.fail(fmt::format("/wall_bounces {} has more than 2^40 points", dims_text(cs.dims)));
         }
     }

@@ -16,15 +16,15 @@
 #include <vector>
 
 #include "hdf5.hpp"
+#include "job/job.hpp"
 #include "job/tiles.hpp"
 #include "result_reader.hpp"
 
 namespace superball::schema {
 
-inline constexpr std::int64_t max_max_bounces = 4294967295;
-// As the job parser: beyond 2^40 points a file is damaged, not big.
-inline constexpr std::uint64_t max_points = std::uint64_t{1} << 40;
-// Texts: a job file is a few hundred bytes; names and versions a few.
+// What a file may hold; beyond it the file is damaged, not big: a job's grid and max_bounces
+// (max_grid_points, max_max_bounces: job/job.hpp), and texts (a job file is a few hundred
+// bytes; names and versions a few).
 inline constexpr std::size_t max_job_bytes = std::size_t{1} << 20;
 inline constexpr std::size_t max_text_bytes = 4096;
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -16,6 +17,13 @@
 #include "core/state.hpp"
 
 namespace superball {
+
+// The limits of a job, which a result file read back must meet too (io/result_schema.cpp).
+// 2^40 points is 1 TiB of counts at one byte each: beyond that a typo is more likely than
+// an intent, and uint64 index arithmetic stays far from overflow.
+inline constexpr std::uint64_t max_grid_points = std::uint64_t{1} << 40;
+// Counts are stored as uint32.
+inline constexpr std::int64_t max_max_bounces = std::numeric_limits<std::uint32_t>::max();
 
 enum class Coordinates { canonical, physical };
 

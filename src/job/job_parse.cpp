@@ -28,11 +28,7 @@
 namespace superball {
 namespace {
 
-// 2^40 points is 1 TiB of counts at one byte each: beyond that a typo is more likely than
-// an intent, and uint64 index arithmetic stays far from overflow.
-constexpr std::uint64_t max_grid_points = std::uint64_t{1} << 40;
 constexpr std::int64_t max_tile_points = std::int64_t{1} << 24;
-constexpr std::int64_t max_max_bounces = std::numeric_limits<std::uint32_t>::max();
 
 const std::vector<std::string> top_level_keys = {"model", "grid", "run"};
 const std::vector<std::string> model_keys = [] {

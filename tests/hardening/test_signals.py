@@ -49,9 +49,9 @@ def signal_env():
 
 # The jobs' max_bounces are set from the speed of the binary under test
 # (wall_impacts_per_second), so that the runs last the same few seconds in a release build
-# and under AddressSanitizer: MEDIUM (killable_job) about 4 s on two ranks; LONG
+# and under AddressSanitizer: MEDIUM (killable_job) about 2 s on two ranks; LONG
 # (capped_job, 8 tiles of 100 capped points) about a second a tile.
-MEDIUM_SECONDS = 4.0
+MEDIUM_SECONDS = 2.0
 TILE_SECONDS = 1.0
 
 
