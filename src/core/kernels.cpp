@@ -58,6 +58,9 @@ bool has_avx2()
            __builtin_cpu_supports("bmi2");
 }
 
+#endif
+
+#ifdef SUPERBALL_SIMD_AVX512
 bool has_avx512()
 {
     return has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&

@@ -2,10 +2,12 @@
 --system-site-packages (its numpy, h5py and xarray are the system's), from a copy of the
 repository as a clone has it, the module is built by CMake for the venv's interpreter and
 installed with its stubs; imported from another folder it counts and opens a result. The
-copy builds the module's libraries from nothing, at -O0 through SUPERBALL_PIP_CMAKE_ARGS
-(setup.py): what is tested is the installation, and every build of superball counts alike
-(-ffp-contract=off); -O0 took 98 CPU-seconds where Release's -O3 took 136 (2026-11-29,
-`cmake --build --target superball_python -j2` of a fresh tree, one after the other)."""
+copy builds the module's libraries from nothing, at -O0 and with clang++ where it is installed
+(.ci/install-deps --dev, which tests/all runs), through SUPERBALL_PIP_CMAKE_ARGS (setup.py): what
+is tested is the installation, and every build of superball counts alike (-ffp-contract=off).
+-O0 took 98 CPU-seconds where Release's -O3 took 136 (2026-11-29, `cmake --build --target
+superball_python -j2` of a fresh tree, one after the other); clang at -O0 59 against GCC's 118
+(2026-11-29, the same way), and the package is then built by a second compiler."""
 import glob
 import os
 import shlex
@@ -45,7 +47,12 @@ class PipInstall(unittest.TestCase):
         cls.venv = os.path.join(cls.tmp, "venv")
         cls.env = {k: v for k, v in mpi_env().items() if not k.startswith(("SUPERBALL", "PYTHON", "LD_"))}
         cls.env["PATH"] = os.path.join(cls.venv, "bin") + ":/usr/bin:/bin"
-        cls.env["SUPERBALL_PIP_CMAKE_ARGS"] = shlex.join(["-DCMAKE_CXX_FLAGS_RELEASE=-O0 -DNDEBUG"])
+        cls.compiler = shutil.which("clang++")
+        cmake_args = ["-DCMAKE_CXX_FLAGS_RELEASE=-O0 -DNDEBUG"]
+        if cls.compiler:
+            cmake_args.append(f"-DCMAKE_CXX_COMPILER={cls.compiler}")
+        print(f"pip builds with {cls.compiler or 'the default C++ compiler'}", file=sys.stderr)
+        cls.env["SUPERBALL_PIP_CMAKE_ARGS"] = shlex.join(cmake_args)
         cls.run_in(cls.tmp, PYTHON, "-m", "venv", "--system-site-packages", cls.venv)
         cls.python = os.path.join(cls.venv, "bin", "python")
         # --no-index: nothing from the network; numpy comes from the system's site packages.
@@ -75,6 +82,8 @@ class PipInstall(unittest.TestCase):
     def test_cmake_args_reach_the_build(self):
         (build,) = glob.glob(os.path.join(self.clone, "build", "pip-*"))
         self.assertEqual(cmake_cache_value(build, "CMAKE_CXX_FLAGS_RELEASE"), "-O0 -DNDEBUG")
+        if self.compiler:
+            self.assertEqual(cmake_cache_value(build, "CMAKE_CXX_COMPILER"), self.compiler)
 
     def test_counts_and_opens_a_result_from_another_folder(self):
         code = ("import superball, sys\n"
